@@ -1,0 +1,89 @@
+"""`python -m derive`: prove, then regenerate generated/; `--check`: fail if stale.
+
+Emission always runs every proof first and stops at the first failure.
+`--check` re-renders in memory and compares bytes with generated/ (it does not
+re-run the proofs: the files it compares were only written after they passed,
+and the source hash in their header ties them to this derive source).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+MODEL_MODULES = ("particle", "planar")
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _reexec_with_fixed_hash_seed() -> None:
+    """SymPy's internal set orders can depend on hash randomisation; fix it so
+    emission is byte-for-byte deterministic."""
+    if os.environ.get("PYTHONHASHSEED") != "0":
+        env = dict(os.environ, PYTHONHASHSEED="0")
+        os.execve(sys.executable, [sys.executable, "-m", "derive", *sys.argv[1:]], env)
+
+
+def render_all() -> dict[str, str]:
+    """File name → text for every file of generated/."""
+    import importlib
+
+    from . import emit
+
+    digest = emit.source_hash()
+    files = {}
+    for name in MODEL_MODULES:
+        mod = importlib.import_module(f"derive.{name}")
+        doc = (mod.__doc__ or "").strip().splitlines()[0]
+        files[f"{name}.py"] = emit.render_module(f"{name}.py", doc, mod.KERNELS, digest)
+    files["codes.py"] = emit.render_codes(digest)
+    files["__init__.py"] = emit.render_init(MODEL_MODULES, digest)
+    return files
+
+
+def run_proofs() -> bool:
+    """Run every model's proofs; print each claim; False if any failed."""
+    import importlib
+
+    ok = True
+    for name in MODEL_MODULES:
+        for claim, passed in importlib.import_module(f"derive.{name}").proofs():
+            print(f"  [{'ok' if passed else 'FAILED'}] {claim}")
+            ok = ok and bool(passed)
+    return ok
+
+
+def stale_files(out: Path) -> list[str]:
+    """Names of generated files that are missing or differ from a fresh render."""
+    return [name for name, text in render_all().items()
+            if not (out / name).exists() or (out / name).read_text() != text]
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m derive", description=__doc__.splitlines()[0])
+    parser.add_argument("--check", action="store_true", help="exit 1 if generated/ is stale")
+    parser.add_argument("--out", type=Path, default=ROOT / "generated",
+                        help="output folder (default: generated/)")
+    args = parser.parse_args(argv)
+    if args.check:
+        stale = stale_files(args.out)
+        if stale:
+            print(f"generated/ is stale: {', '.join(stale)}; run `python -m derive`")
+            return 1
+        print("generated/ is up to date")
+        return 0
+    print("proving:")
+    if not run_proofs():
+        print("a proof failed: nothing emitted")
+        return 1
+    args.out.mkdir(parents=True, exist_ok=True)
+    for name, text in render_all().items():
+        (args.out / name).write_text(text)
+        print(f"wrote {args.out / name}")
+    return 0
+
+
+if __name__ == "__main__":
+    _reexec_with_fixed_hash_seed()
+    sys.exit(main())

@@ -1,0 +1,21 @@
+"""Row status codes and physics flag bits shared by every generated kernel.
+
+A kernel returns ``status`` (0 = solved; otherwise the row's outputs are NaN) and
+``flags`` (a bit field that marks physically impossible results of a solved row).
+The numbers are part of the public interface (conventions.md): never renumber.
+"""
+
+STATUS = {
+    "OK": 0,
+    "NONFINITE_INPUT": 1,
+    "BAD_MASS": 2,
+    "NOT_APPROACHING": 3,
+    "SINGULAR": 4,
+    "OVERFLOW": 5,
+}
+
+FLAGS = {
+    "ENERGY_CREATED": 1,
+    "TENSILE_IMPULSE": 2,
+    "MU_BEYOND_CRITICAL": 4,
+}

@@ -1,0 +1,100 @@
+"""What a model module hands to the emitter: a kernel as ordered blocks of formulas.
+
+A kernel is a straight-line program. Its blocks are evaluated in order; every
+formula in a block may use the kernel inputs and the symbols assigned by earlier
+blocks, never a symbol of its own block (the emitter eliminates common
+subexpressions inside a block, so that rule keeps temporaries in order). A block
+may end with a guard: a condition that must hold for the row to go on, and the
+status the row gets when it does not. Guards sit before the divisions and
+transcendental calls they protect, so the plain-Python twin of a kernel never
+raises.
+
+Named intermediate symbols are how a derivation keeps a physical difference
+(the approach velocity at the impact centre, ``1 - e``) as one rounded quantity:
+once assigned, later blocks use the symbol, and no later simplification can
+re-form the difference from large products.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import sympy as sp
+
+
+@dataclass(frozen=True)
+class Guard:
+    """Every one of `conditions` must be true for the row to continue; otherwise
+    the row gets `status`. Conditions are kept in the order given (no SymPy
+    `And`, which would reorder them)."""
+
+    conditions: tuple
+    status: str
+
+
+@dataclass(frozen=True)
+class Block:
+    """Assignments evaluated together (CSE runs over the block), then a guard."""
+
+    assigns: tuple[tuple[sp.Symbol, sp.Expr], ...]
+    guard: Guard | None = None
+
+
+@dataclass(frozen=True)
+class Kernel:
+    """A per-scene function plus its batch drivers, as the emitter writes them.
+
+    `inputs` are the argument names (the batch column names of conventions.md),
+    `checks` the input guards evaluated before any arithmetic, `blocks` the
+    formulas, `outputs` the returned symbols in order (then `status`, `flags`),
+    and `flags` pairs of (flag name, conditions any of which raises it) on a
+    solved row.
+    """
+
+    name: str
+    doc: str
+    inputs: tuple[sp.Symbol, ...]
+    checks: tuple[Guard, ...]
+    blocks: tuple[Block, ...]
+    outputs: tuple[sp.Symbol, ...]
+    flags: tuple[tuple[str, tuple], ...] = field(default_factory=tuple)
+
+    def output_names(self) -> tuple[str, ...]:
+        """Public output names (batch columns): `mu_used` is published as `mu`."""
+        return tuple("mu" if s.name == "mu_used" else s.name for s in self.outputs)
+
+    def definitions(self) -> dict[sp.Symbol, sp.Expr]:
+        """Every assigned symbol with its formula, in evaluation order."""
+        return {sym: expr for block in self.blocks for sym, expr in block.assigns}
+
+    def expanded(self, expr: sp.Expr, keep: frozenset = frozenset()) -> sp.Expr:
+        """`expr` with assigned symbols replaced by their formulas, down to the
+        inputs, except the symbols in `keep` (used by proofs to stop at inverse
+        masses and the normal's components)."""
+        defs = self.definitions()
+        for sym in reversed(list(defs)):
+            if sym not in keep:
+                expr = expr.xreplace({sym: defs[sym]})
+        return expr
+
+
+def real(names: str):
+    """Real SymPy symbols, as a tuple (or one symbol for one name)."""
+    return sp.symbols(names, real=True)
+
+
+class IsFinite(sp.Function):
+    """`math.isfinite(x)` as a SymPy function, for input guards."""
+
+
+def finite_inputs(symbols) -> Guard:
+    """Guard: every one of `symbols` is a finite number (not NaN, not inf)."""
+    return Guard(tuple(IsFinite(s) for s in symbols), "NONFINITE_INPUT")
+
+
+def positive_or_fixed(symbols) -> Guard:
+    """Guard: masses/inertias are > 0 (NaN fails the comparison); +inf is a fixed body.
+
+    The comparison is built on assumption-free copies of the symbols: the model
+    symbols are declared positive, which would make SymPy fold `m > 0` to True."""
+    return Guard(tuple(sp.StrictGreaterThan(sp.Symbol(s.name), 0) for s in symbols), "BAD_MASS")

@@ -1,0 +1,362 @@
+"""Brach's general planar rigid-body impact model (seed appendix, conventions.md).
+
+Six equations for six unknown final velocities (V1x, V1y, W1, V2x, V2y, W2):
+linear and angular impulse-momentum for each body, restitution e at the impact
+centre, the impulse ratio μ = Pt/Pn (or no sliding at separation, μ = μ_c), and
+moment restitution (W2 - W1)(1 - e_m) = e_m·M·(1/I1 + 1/I2).
+
+The derivation works in impulse space. The momentum equations give the change
+of the relative velocity at the impact centre and of the relative yaw rate as a
+linear map of (Pn, Pt, M): a symmetric compliance matrix C. Moment restitution
+gives M in terms of (Pn, Pt); eliminating it leaves an effective 2x2 compliance
+K and a coupling h to the initial relative yaw rate. Restitution plus the
+impulse ratio (or sticking) then fix (Pn, Pt). Every quantity is a named,
+rounded-once intermediate; energy loss is the work of the impulse components.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+from . import frame as f
+from . import particle
+from .frame import (
+    I1, I2, M, Pn, Pt, Px, Py, TL, TLm, TLn, TLt, V1x, V1y, V2x, V2y, W1, W2,
+    dgn, dvx, dvy, e, e_m, gamma, gn, gt, gx, gy, j1, j2, k1, k2, m1, m2, mu, mu_c,
+    mu_used, nx, ny, r1x, r1y, r2x, r2y, v1x, v1y, v2x, v2y, w1, w2, wr,
+)
+from .kernel import Block, Guard, IsFinite, Kernel, finite_inputs, positive_or_fixed, real
+
+INPUTS = (m1, m2, I1, I2, v1x, v1y, w1, v2x, v2y, w2, r1x, r1y, r2x, r2y, gamma, e, mu, e_m)
+OUTPUTS = (V1x, V1y, W1, V2x, V2y, W2, Pn, Pt, M, mu_used, mu_c, TL, TLn, TLt, TLm)
+
+r1n, r1t, r2n, r2t = real("r1n r1t r2n r2t")
+Cnn, Cnt, Ctt, Cnm, Ctm, Cmm = real("Cnn Cnt Ctt Cnm Ctm Cmm")
+Knn, Knt, Ktt, hn, ht, am = real("Knn Knt Ktt hn ht am")
+bn, bt, D, Dc, s, c1, c2 = real("bn bt D Dc s c1 c2")
+
+
+def _perp(rn, rt):
+    """z × r in impact-frame components: the velocity of a point at r per unit yaw rate."""
+    return sp.Matrix([-rt, rn])
+
+
+def _cross(rn, rt, an, at):
+    """Scalar cross product r × a (frame invariant: n × t = 1)."""
+    return rn * at - rt * an
+
+
+def relative_velocity():
+    """u2 - u1 in the scene frame from u_i = v_i + w_i (-r_iy, r_ix), written
+    with v2 - v1 formed first (dvx, dvy), so equal large speeds cancel exactly."""
+    u1 = sp.Matrix([v1x - w1 * r1y, v1y + w1 * r1x])
+    u2 = sp.Matrix([v2x - w2 * r2y, v2y + w2 * r2x])
+    g = (u2 - u1).xreplace({v2x: dvx + v1x, v2y: dvy + v1y})
+    return sp.expand(g[0]), sp.expand(g[1])
+
+
+def compliance():
+    """The symmetric matrix C with (Δgn, Δgt, Δwr) = -C (Pn, Pt, M), derived from
+    the linear and angular impulse-momentum equations of both bodies."""
+    P = sp.Matrix([Pn, Pt])
+    dU1 = k1 * P + j1 * (_cross(r1n, r1t, Pn, Pt) + M) * _perp(r1n, r1t)
+    dU2 = -k2 * P - j2 * (_cross(r2n, r2t, Pn, Pt) + M) * _perp(r2n, r2t)
+    dg = dU2 - dU1
+    dwr = -j2 * (_cross(r2n, r2t, Pn, Pt) + M) - j1 * (_cross(r1n, r1t, Pn, Pt) + M)
+    return -sp.Matrix([dg[0], dg[1], dwr]).jacobian([Pn, Pt, M]).applyfunc(sp.expand)
+
+
+def moment_impulse():
+    """M solved from moment restitution, (Wr)(1 - e_m) = e_m·M·Cmm, Wr = wr + Δwr."""
+    wr_final = wr - (Cnm * Pn + Ctm * Pt + Cmm * M)
+    return sp.solve(sp.Eq(wr_final * (1 - e_m), e_m * M * Cmm), M)[0]
+
+
+def _frame_blocks():
+    """Inverse masses, the normal, relative motion at the impact centre, C."""
+    r1n_, r1t_ = f.to_impact_frame(r1x, r1y)
+    r2n_, r2t_ = f.to_impact_frame(r2x, r2y)
+    gx_, gy_ = relative_velocity()
+    gn_, gt_ = f.to_impact_frame(gx, gy)
+    C = compliance()
+    return (
+        Block(
+            f.inverse_masses((m1, m2, I1, I2), (k1, k2, j1, j2))
+            + f.normal_components()
+            + ((dvx, v2x - v1x), (dvy, v2y - v1y), (wr, w2 - w1)),
+            Guard((sp.StrictGreaterThan(k1 + k2, 0), sp.StrictGreaterThan(j1 + j2, 0)),
+                  "SINGULAR"),
+        ),
+        Block(((r1n, r1n_), (r1t, r1t_), (r2n, r2n_), (r2t, r2t_), (gx, gx_), (gy, gy_))),
+        Block(
+            ((gn, gn_), (gt, gt_), (Cnn, C[0, 0]), (Cnt, C[0, 1]), (Ctt, C[1, 1]),
+             (Cnm, C[0, 2]), (Ctm, C[1, 2]), (Cmm, C[2, 2]),
+             # 1 - e_m kept as one factor: e_m = 1 gives exactly no moment impulse.
+             (am, (1 - e_m) / C[2, 2])),
+            f.approach_guard(),
+        ),
+    )
+
+
+def effective_compliance():
+    """K and h of Δ(gn, gt) = -K (Pn, Pt) - h once M is eliminated (am = (1 - e_m)/Cmm)."""
+    return {
+        Knn: Cnn - am * Cnm**2,
+        Knt: Cnt - am * Cnm * Ctm,
+        Ktt: Ctt - am * Ctm**2,
+        hn: am * Cnm * wr,
+        ht: am * Ctm * wr,
+    }
+
+
+def _impulse_blocks(sticking: bool):
+    """Restitution plus impulse ratio (sliding) or zero final slip (sticking)."""
+    keff = effective_compliance()
+    # Restitution: Δgn = -(1 + e)·gn =: dgn; K (Pn, Pt) = (bn, bt) with
+    # bn = -(dgn + hn) and, for sticking (Δgt = -gt), bt = gt - ht.
+    pn_c, pt_c = (Ktt * bn - Knt * bt), (Knn * bt - Knt * bn)
+    if sticking:
+        denom, pn, pt = (D, Knn * Ktt - Knt**2), pn_c / D, pt_c / D
+    else:
+        denom, pn, pt = (D, Knn + mu * Knt), bn / D, mu * bn / D
+    return (
+        Block(tuple(keff.items()) + ((dgn, -(1 + e) * gn),)),
+        Block(((bn, -(dgn + hn)), (bt, gt - ht))),
+        Block((denom, (Dc, pn_c)),
+              Guard((sp.Ne(D, 0), sp.Ne(Dc, 0)), "SINGULAR")),
+        # μ_c: the ratio Pt/Pn of the sticking solution (det K cancels).
+        Block(((mu_c, pt_c / Dc), (Pn, pn), (Pt, pt))),
+    )
+
+
+def _final_blocks(sticking: bool):
+    """Finals from the impulses, and energy loss as the work of each component."""
+    px, py = f.to_scene_frame(Pn, Pt)
+    gt_final = 0 if sticking else gt - (Knt * Pn + Ktt * Pt) - ht
+    return (
+        Block(
+            (
+                (Px, px), (Py, py),
+                (c1, _cross(r1n, r1t, Pn, Pt)), (c2, _cross(r2n, r2t, Pn, Pt)),
+                # Relative yaw rate at separation if there were no moment impulse.
+                (s, wr - (Cnm * Pn + Ctm * Pt)),
+                (mu_used, mu_c if sticking else mu),
+                # (gn + Gn) with Gn = -e·gn factors to (1 - e)·gn (see particle).
+                (TLn, Pn * sp.factor(gn - e * gn) / 2),
+                (TLt, Pt * (gt + gt_final) / 2),
+            )
+        ),
+        Block(
+            (
+                (M, am * s),
+                (V1x, v1x + k1 * Px), (V1y, v1y + k1 * Py),
+                (V2x, v2x - k2 * Px), (V2y, v2y - k2 * Py),
+            )
+        ),
+        Block(
+            (
+                (W1, w1 + j1 * (c1 + M)),
+                (W2, w2 - j2 * (c2 + M)),
+                # W2 - W1 = e_m·s at separation.
+                (TLm, M * (wr + e_m * s) / 2),
+            )
+        ),
+        Block(((TL, TLn + TLt + TLm),)),
+    )
+
+
+def kernel(sticking: bool) -> Kernel:
+    """The rigid-body kernel, impulse ratio given (sliding) or μ = μ_c (sticking)."""
+    name = "rigid_critical" if sticking else "rigid"
+    doc = ("General planar rigid-body impact (Brach), "
+           + ("no sliding at separation (mu = mu_c)." if sticking else "impulse ratio mu given."))
+    scalars = (v1x, v1y, w1, v2x, v2y, w2, r1x, r1y, r2x, r2y, gamma, e, e_m)
+    tolerances, flags = f.physics_flags((TL, TLn, TLt, TLm), ((Pn, gn), (Pt, gt), (M, wr)))
+    return Kernel(
+        name=name,
+        doc=doc,
+        inputs=INPUTS,
+        checks=(
+            finite_inputs(scalars + (() if sticking else (mu,))),
+            positive_or_fixed((m1, m2, I1, I2)),
+            # A fixed body has infinite mass AND inertia, or neither.
+            Guard((sp.Eq(IsFinite(m1), IsFinite(I1)), sp.Eq(IsFinite(m2), IsFinite(I2))),
+                  "BAD_MASS"),
+        ),
+        blocks=_frame_blocks() + _impulse_blocks(sticking) + _final_blocks(sticking)
+        + (tolerances,),
+        outputs=OUTPUTS,
+        flags=flags,
+    )
+
+
+KERNELS = (kernel(sticking=False), kernel(sticking=True))
+
+
+# ---------------------------------------------------------------- proofs
+
+KEEP = frozenset({k1, k2, j1, j2, nx, ny})
+
+
+def _zero(expr) -> bool:
+    return f.reduce_unit_normal(expr) == 0
+
+
+def _six_equation_residuals(got, sticking: bool):
+    """Residuals of the six equations (conventions.md) in the scene frame."""
+    px, py = got[Px], got[Py]
+    u1 = (v1x - w1 * r1y, v1y + w1 * r1x)
+    u2 = (v2x - w2 * r2y, v2y + w2 * r2x)
+    U1 = (got[V1x] - got[W1] * r1y, got[V1y] + got[W1] * r1x)
+    U2 = (got[V2x] - got[W2] * r2y, got[V2y] + got[W2] * r2x)
+    n, t = (nx, ny), (-ny, nx)
+
+    def dot(a, b):
+        return a[0] * b[0] + a[1] * b[1]
+
+    rel = (U2[0] - U1[0], U2[1] - U1[1])
+    res = [
+        got[V1x] - v1x - k1 * px, got[V1y] - v1y - k1 * py,
+        got[V2x] - v2x + k2 * px, got[V2y] - v2y + k2 * py,
+        got[W1] - w1 - j1 * (r1x * py - r1y * px + got[M]),
+        got[W2] - w2 + j2 * (r2x * py - r2y * px + got[M]),
+        dot(n, rel) + e * dot(n, (u2[0] - u1[0], u2[1] - u1[1])),
+        (got[W2] - got[W1]) * (1 - e_m) - e_m * got[M] * (j1 + j2),
+        dot(t, rel) if sticking else dot(t, (px, py)) - mu * dot(n, (px, py)),
+    ]
+    return res, rel
+
+
+def _six_equations_hold(knl: Kernel, sticking: bool) -> bool:
+    """The six equations, in three exact steps:
+    1. with (Pn, Pt) free and the kernel's M(Pn, Pt), momentum, angular impulse
+       and moment restitution hold identically, and the final relative velocity
+       at the impact centre is (gn, gt) - K (Pn, Pt) - h (K, h expanded);
+    2. the kernel's (Pn, Pt), as functions of K, h, gn, gt, e, μ, satisfy
+       restitution and the impulse ratio (or zero final slip);
+    3. so the scene-frame restitution and ratio residuals vanish."""
+    at = KEEP | {Pn, Pt}
+    free = {sym: knl.expanded(sym, at) for sym in knl.outputs + (Px, Py)}
+    res, rel = _six_equation_residuals(free, sticking)
+    Gn, Gt = f.to_impact_frame(*rel)
+    keff = {sym: knl.expanded(sym, KEEP) for sym in (Knn, Knt, Ktt, hn, ht, gn, gt)}
+    step1 = all(_zero(r) for r in res[:6] + res[7:8]) and _zero(
+        Gn - (keff[gn] - keff[Knn] * Pn - keff[Knt] * Pt - keff[hn])) and _zero(
+        Gt - (keff[gt] - keff[Knt] * Pn - keff[Ktt] * Pt - keff[ht]))
+    small = frozenset({Knn, Knt, Ktt, hn, ht, gn, gt})
+    pn, pt = knl.expanded(Pn, small), knl.expanded(Pt, small)
+    restitution = (gn - Knn * pn - Knt * pt - hn) + e * gn
+    second = (gt - Knt * pn - Ktt * pt - ht) if sticking else pt - mu * pn
+    step2 = sp.simplify(restitution) == 0 and sp.simplify(second) == 0
+    pn_back, pt_back = f.to_impact_frame(free[Px], free[Py])
+    step3 = _zero(pn_back - Pn) and _zero(pt_back - Pt)
+    return step1 and step2 and step3
+
+
+def _derivation_checks():
+    """C is symmetric; the structured K, h equal SymPy's elimination of M."""
+    C = compliance()
+    out = [("rigid: compliance C is symmetric (reciprocity)", C == C.T)]
+    m_sol = moment_impulse()
+    C_syms = {Cnn: C[0, 0], Cnt: C[0, 1], Ctt: C[1, 1], Cnm: C[0, 2], Ctm: C[1, 2], Cmm: C[2, 2]}
+    dg = -sp.Matrix([[Cnn, Cnt, Cnm], [Cnt, Ctt, Ctm]]) * sp.Matrix([Pn, Pt, m_sol])
+    keff = {k: v.xreplace({am: (1 - e_m) / Cmm}) for k, v in effective_compliance().items()}
+    structured = -sp.Matrix([[keff[Knn], keff[Knt]], [keff[Knt], keff[Ktt]]]) * sp.Matrix([Pn, Pt]) \
+        - sp.Matrix([keff[hn], keff[ht]])
+    out.append(("rigid: eliminating M (moment restitution) gives the effective K and h",
+                all(_zero((dg[i] - structured[i]).xreplace(C_syms)) for i in range(2))))
+    return out
+
+
+def _kernel_checks(knl: Kernel, sticking: bool, sliding: Kernel | None = None):
+    """Proofs for one kernel. The six equations are checked on the closed forms
+    expanded down to the inputs. The energy claims are checked as lemmas with
+    (Pn, Pt) or (Pn, Pt, M) kept as free symbols, where the difference must be
+    an identity or a multiple of a residual already proven zero; that keeps
+    every check exact and fast."""
+    tag = knl.name
+    got = {sym: knl.expanded(sym, KEEP) for sym in knl.outputs + (Px, Py)}
+    out = [(f"{tag}: the closed forms satisfy the six equations",
+            _six_equations_hold(knl, sticking))]
+    g0 = tuple(c.xreplace({dvx: v2x - v1x, dvy: v2y - v1y}) for c in relative_velocity())
+    gn0, gt0 = f.to_impact_frame(*g0)
+    wr0 = w2 - w1
+    # Lemma: for ANY impulse (Pn, Pt, M), the kinetic energy lost is the work of
+    # the components on the mean relative velocity (conventions.md, Energy).
+    free = {sym: knl.expanded(sym, KEEP | {Pn, Pt, M}) for sym in (V1x, V1y, W1, V2x, V2y, W2)}
+    _, rel = _six_equation_residuals({**free, Px: knl.expanded(Px, KEEP | {Pn, Pt}),
+                                      Py: knl.expanded(Py, KEEP | {Pn, Pt}), M: M}, sticking)
+    Gn, Gt = f.to_impact_frame(*rel)
+    ke = [(vx**2 + vy**2) / (2 * k) + w**2 / (2 * j)
+          for vx, vy, w, k, j in ((v1x, v1y, w1, k1, j1), (v2x, v2y, w2, k2, j2))]
+    KE = [(free[a]**2 + free[b]**2) / (2 * k) + free[c]**2 / (2 * j)
+          for a, b, c, k, j in ((V1x, V1y, W1, k1, j1), (V2x, V2y, W2, k2, j2))]
+    work = Pn * (gn0 + Gn) / 2 + Pt * (gt0 + Gt) / 2 + M * (wr0 + free[W2] - free[W1]) / 2
+    out.append((f"{tag}: kinetic energy lost = work of Pn, Pt, M (any impulse)",
+                _zero(sum(ke) - sum(KE) - work)))
+    # The kernel's parts, with (Pn, Pt) free and M the kernel's M(Pn, Pt).
+    at = KEEP | {Pn, Pt}
+    m_k = knl.expanded(M, at)
+    Gn_k, Gt_k, Wr_k = (x.xreplace({M: m_k}) for x in (Gn, Gt, free[W2] - free[W1]))
+    restitution = Gn_k + e * gn0
+    slip = Gt_k if sticking else 0
+    out.append((f"{tag}: TLn, TLt, TLm are those works given restitution"
+                + (" and zero final slip" if sticking else ""),
+                _zero(knl.expanded(TLn, at) - Pn * (gn0 + Gn_k) / 2 + Pn * restitution / 2)
+                and _zero(knl.expanded(TLt, at) - Pt * (gt0 + Gt_k) / 2 + Pt * slip / 2)
+                and _zero(knl.expanded(TLm, at) - m_k * (wr0 + Wr_k) / 2)
+                and sp.expand(got[TL] - got[TLn] - got[TLt] - got[TLm]) == 0))
+    if sticking:
+        out.append((f"{tag}: equals the sliding kernel at mu = mu_c",
+                    _sticking_is_sliding_at_critical(knl, sliding)))
+    else:
+        out.append((f"{tag}: mu = mu_c makes the final tangential relative velocity vanish",
+                    _critical_ratio_ends_slip(knl, Gt_k)))
+        out.append((f"{tag}: zero lever arms reduce to the particle model, eqs 10-13",
+                    _reduces_to_particle(got)))
+    return out
+
+
+def _sticking_is_sliding_at_critical(stick: Kernel, slide: Kernel) -> bool:
+    """Same finals as functions of (Pn, Pt), and the same (Pn, Pt) at μ = μ_c
+    (an identity in K, bn, bt)."""
+    at = KEEP | {Pn, Pt}
+    same_finals = all(sp.expand(stick.expanded(o, at) - slide.expanded(o, at)) == 0
+                      for o in (V1x, V1y, W1, V2x, V2y, W2, M))
+    small = frozenset({Knn, Knt, Ktt, bn, bt})
+    crit = {mu: slide.expanded(mu_c, small)}
+    same_impulse = all(
+        sp.simplify(stick.expanded(o, small) - slide.expanded(o, small).xreplace(crit)) == 0
+        for o in (Pn, Pt))
+    return same_finals and same_impulse
+
+
+def _critical_ratio_ends_slip(knl: Kernel, gt_final) -> bool:
+    """Gt = bt - (Knt Pn + Ktt Pt) for any (Pn, Pt) (lemma, expanded), and with
+    the kernel's Pn, Pt at μ = μ_c that is zero (identity in K, bn, bt)."""
+    small = frozenset({Knn, Knt, Ktt, bn, bt})
+    lemma = _zero(gt_final - knl.expanded(bt - (Knt * Pn + Ktt * Pt), KEEP | {Pn, Pt}))
+    at_small = knl.expanded(bt - (Knt * Pn + Ktt * Pt), small)
+    return lemma and sp.simplify(at_small.xreplace({mu: knl.expanded(mu_c, small)})) == 0
+
+
+def _reduces_to_particle(got) -> bool:
+    """With r1 = r2 = 0 the translational results are the seed's eqs 10–13."""
+    zero_arms = {r1x: 0, r1y: 0, r2x: 0, r2y: 0}
+    printed = particle.seed_printed_solution(sticking=False)
+    vals = particle._seed_frame_values()
+    for (sx, sy), (sn, st) in (((V1x, V1y), (particle.V1n, particle.V1t)),
+                               ((V2x, V2y), (particle.V2n, particle.V2t))):
+        fn, ft = f.to_impact_frame(got[sx].xreplace(zero_arms), got[sy].xreplace(zero_arms))
+        if not (_zero(fn - printed[sn].xreplace(vals)) and _zero(ft - printed[st].xreplace(vals))):
+            return False
+    return True
+
+
+def proofs():
+    """(claim, passed) pairs for the rigid-body kernels."""
+    out = _derivation_checks()
+    sliding, sticking = KERNELS
+    out += _kernel_checks(sliding, False)
+    out += _kernel_checks(sticking, True, sliding)
+    return out

@@ -1,0 +1,25 @@
+"""impactsym: the impact phase of planar vehicle collisions.
+
+Closed forms derived with SymPy (``derive/``) and emitted as numba kernels
+(``generated/``) for the two-particle model and Brach's planar rigid-body model,
+as reviewed in "A Review of Impact Models for Vehicle Collision". Frame, signs
+and units: conventions.md (n from vehicle 1 toward vehicle 2; P is the impulse
+on vehicle 1; lower case initial, upper case final).
+
+    import impactsym
+    result = impactsym.solve("examples/two_car_us.json")
+    table = impactsym.solve_batch(columns, model="rigid")
+"""
+
+from .batch import solve_batch
+from .codes import FLAG_MESSAGES, STATUS_MESSAGES, describe_flags, describe_status
+from .result import Result
+from .scene import Impact, Scene, SceneError, Vehicle, load_scene
+from .single import solve
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "FLAG_MESSAGES", "STATUS_MESSAGES", "Impact", "Result", "Scene", "SceneError", "Vehicle",
+    "describe_flags", "describe_status", "load_scene", "solve", "solve_batch",
+]

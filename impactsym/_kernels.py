@@ -1,0 +1,83 @@
+"""The runtime's door to generated/: which kernel serves which scene.
+
+A single scene runs the kernel's plain-Python twin (`.py_func`): the same
+generated code, with no JIT compile. Batches run the numba drivers: the serial
+twin below `SERIAL_BELOW` rows (a `prange` launch costs more than it saves),
+the parallel one above.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+import generated
+
+if getattr(generated, "IMPACTSYM_GENERATED", None) != "impactsym":
+    raise ImportError(
+        f"the module 'generated' at {getattr(generated, '__file__', '?')} is not "
+        "impactsym's generated kernels (another package named 'generated' shadows it)"
+    )
+
+from generated import particle, planar  # noqa: E402
+
+SERIAL_BELOW = 64
+
+OUTPUTS = ("V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M",
+           "mu", "mu_c", "TL", "TLn", "TLt", "TLm")
+
+
+@dataclass(frozen=True)
+class KernelSet:
+    """One generated kernel: per-scene function, batch drivers, names."""
+
+    scene: Callable
+    batch: Callable
+    serial: Callable
+    inputs: tuple[str, ...]
+    outputs: tuple[str, ...]
+
+
+def _kernel_set(module, name: str) -> KernelSet:
+    upper = name.upper()
+    return KernelSet(
+        scene=getattr(module, name),
+        batch=getattr(module, f"{name}_batch"),
+        serial=getattr(module, f"{name}_batch_serial"),
+        inputs=getattr(module, f"{upper}_INPUTS"),
+        outputs=getattr(module, f"{upper}_OUTPUTS"),
+    )
+
+
+KERNELS = {
+    ("rigid", False): _kernel_set(planar, "rigid"),
+    ("rigid", True): _kernel_set(planar, "rigid_critical"),
+    ("particle", False): _kernel_set(particle, "particle"),
+    ("particle", True): _kernel_set(particle, "particle_critical"),
+}
+
+MODELS = ("rigid", "particle")
+
+
+def kernel_for(model: str, critical: bool) -> KernelSet:
+    """The kernel for a model name and impulse-ratio mode; ValueError if unknown."""
+    if model not in MODELS:
+        raise ValueError(f"model: unknown model {model!r} (use one of {', '.join(MODELS)})")
+    return KERNELS[(model, bool(critical))]
+
+
+def solve_one(model: str, critical: bool, values: dict) -> dict:
+    """Solve one scene without compiling: `values` maps input names to floats
+    (gamma in radians; `mu` is ignored and may be absent when `critical`).
+    Returns every name of `OUTPUTS` plus int `status` and `flags`."""
+    ks = kernel_for(model, critical)
+    args = [float(values.get(name, 0.0)) if name == "mu" and critical else float(values[name])
+            for name in ks.inputs]
+    *outs, status, flags = ks.scene.py_func(*args)
+    result = dict(zip(ks.outputs, outs))
+    for name in OUTPUTS:
+        if name not in result:
+            result[name] = 0.0 if status == 0 else math.nan
+    result["status"], result["flags"] = int(status), int(flags)
+    return result

@@ -1,0 +1,94 @@
+"""`solve_batch`: many scenes at once through the generated numba drivers.
+
+Columns follow conventions.md (struct of arrays, float64, angles in radians).
+A bad row never stops the batch: it gets a non-zero `status` and NaN outputs.
+A bad *column* (missing, wrong length, not numeric) is a whole-batch error.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import _kernels
+from ._kernels import OUTPUTS
+
+
+def _is_dataframe(obj) -> bool:
+    return type(obj).__module__.startswith("pandas") and hasattr(obj, "columns")
+
+
+def _as_column(columns, name: str, n: int | None) -> np.ndarray:
+    """One input column as a contiguous float64 array; a scalar is broadcast."""
+    if name not in columns:
+        raise ValueError(f"{name}: missing column")
+    try:
+        arr = np.asarray(columns[name], dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name}: not a numeric column ({exc})") from None
+    if arr.ndim > 1:
+        raise ValueError(f"{name}: must be one-dimensional, got shape {arr.shape}")
+    if arr.ndim == 1 and n is not None and arr.shape[0] != n:
+        raise ValueError(f"{name}: length {arr.shape[0]} differs from the other columns ({n})")
+    return arr
+
+
+def _row_count(columns, names) -> int:
+    """The common length of the array columns (1 if all are scalars)."""
+    lengths = {np.ndim(columns[k]) and len(columns[k]) for k in names if k in columns}
+    lengths.discard(0)
+    return max(lengths) if lengths else 1
+
+
+def _critical_mode(columns) -> bool:
+    """True when `mu` is the string "critical" (the sticking kernels)."""
+    mu = columns["mu"] if "mu" in columns else None
+    return isinstance(mu, str) and mu == "critical"
+
+
+def solve_batch(columns, model: str = "rigid"):
+    """Solve one scene per row with the generated kernels.
+
+    `columns` maps input names to equal-length float64 arrays (a dict or a
+    pandas DataFrame): ``m1 m2 I1 I2 v1x v1y w1 v2x v2y w2 r1x r1y r2x r2y gamma
+    e mu e_m`` for the rigid model, ``m1 m2 v1x v1y v2x v2y gamma e mu`` for
+    particles. Units are consistent SI (kg, m, kg·m², m/s, rad/s) or US (slug,
+    ft, slug·ft², ft/s, rad/s); `gamma` (the normal angle Γ) is in radians. A
+    fixed body is ``m = I = inf``. ``mu="critical"`` uses the critical impulse
+    ratio (no sliding at separation) for every row; a scalar is broadcast.
+
+    Returns the same kind of mapping with ``V1x V1y W1 V2x V2y W2 Pn Pt M mu
+    mu_c TL TLn TLt TLm`` (float64) and ``status`` and ``flags`` (int32): see
+    `impactsym.codes` for their meanings.
+    """
+    critical = _critical_mode(columns)
+    ks = _kernels.kernel_for(model, critical)
+    names = [k for k in ks.inputs if not (critical and k == "mu")]
+    n = _row_count(columns, names)
+    inputs = []
+    for name in ks.inputs:
+        if critical and name == "mu":
+            inputs.append(np.zeros(n))
+            continue
+        arr = _as_column(columns, name, n)
+        inputs.append(np.ascontiguousarray(np.broadcast_to(arr, (n,))))
+    outs = {name: np.empty(n) for name in ks.outputs}
+    status = np.empty(n, dtype=np.int32)
+    flags = np.empty(n, dtype=np.int32)
+    driver = ks.serial if n < _kernels.SERIAL_BELOW else ks.batch
+    driver(*inputs, *outs.values(), status, flags)
+    result = {name: outs[name] if name in outs else _filler(status, n) for name in OUTPUTS}
+    result["status"], result["flags"] = status, flags
+    if _is_dataframe(columns):
+        import pandas as pd
+
+        return pd.DataFrame(result, index=columns.index)
+    return result
+
+
+def _filler(status: np.ndarray, n: int) -> np.ndarray:
+    """Zeros for a quantity the model does not have (particles: yaw, moment),
+    NaN on the rows that were not solved."""
+    out = np.zeros(n)
+    out[status != 0] = np.nan
+    return out
+

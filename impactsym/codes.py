@@ -1,0 +1,68 @@
+"""Row status codes and physics flag bits, with the messages users see.
+
+Batch results carry an integer ``status`` per row (0 = solved; otherwise the
+row's outputs are NaN and the other rows are unaffected) and an integer
+``flags`` bit field that marks physically impossible results of a solved row:
+
+====== ======================================================================
+status meaning
+====== ======================================================================
+0      solved
+1      an input is NaN or infinite (only a fixed body's mass/inertia may be inf)
+2      a mass or yaw inertia is not positive, or a body has infinite mass but
+       finite inertia (or the reverse): a fixed body needs both infinite
+3      the vehicles are not approaching at the impact centre, n·(u2 - u1) >= 0
+4      singular: both bodies fixed, or the impact equations have no unique
+       solution for these coefficients
+5      a result overflowed (not finite)
+====== ======================================================================
+
+====== ======================================================================
+flag   meaning (bits add up)
+====== ======================================================================
+1      energy created: TL < 0 or one of TLn, TLt, TLm < 0
+2      tensile normal impulse: Pn >= 0 (a compressive impulse on vehicle 1
+       points along -n)
+4      impulse ratio beyond critical: mu not between 0 and mu_c
+====== ======================================================================
+"""
+
+from __future__ import annotations
+
+from generated import codes as _codes
+
+STATUS_OK = _codes.STATUS_OK
+FLAG_ENERGY_CREATED = _codes.FLAG_ENERGY_CREATED
+FLAG_TENSILE_IMPULSE = _codes.FLAG_TENSILE_IMPULSE
+FLAG_MU_BEYOND_CRITICAL = _codes.FLAG_MU_BEYOND_CRITICAL
+
+STATUS_MESSAGES = {
+    _codes.STATUS_OK: "solved",
+    _codes.STATUS_NONFINITE_INPUT: "an input is NaN or infinite "
+    "(only a fixed body's mass and yaw inertia may be infinite)",
+    _codes.STATUS_BAD_MASS: "a mass or yaw inertia is not a positive number, or a body has "
+    "infinite mass but finite yaw inertia (a fixed body needs both infinite)",
+    _codes.STATUS_NOT_APPROACHING: "the vehicles are not approaching at the impact centre "
+    "(n·(u2 - u1) >= 0; n must point from vehicle 1 toward vehicle 2)",
+    _codes.STATUS_SINGULAR: "singular impact equations (both bodies fixed, or no unique "
+    "impulse for these coefficients)",
+    _codes.STATUS_OVERFLOW: "a result is not finite (overflow)",
+}
+
+FLAG_MESSAGES = {
+    FLAG_ENERGY_CREATED: "energy created: the energy loss or one of its parts is negative, "
+    "which is physically impossible (check the impulse ratio and restitution)",
+    FLAG_TENSILE_IMPULSE: "tensile normal impulse: the vehicles would pull on each other",
+    FLAG_MU_BEYOND_CRITICAL: "impulse ratio mu is not between 0 and the critical ratio mu_c: "
+    "the friction impulse would reverse the sliding (seed Table 2)",
+}
+
+
+def describe_status(status: int) -> str:
+    """The message for a row status code."""
+    return STATUS_MESSAGES.get(int(status), f"unknown status {int(status)}")
+
+
+def describe_flags(flags: int) -> list[str]:
+    """One message per flag bit set in `flags`, lowest bit first."""
+    return [msg for bit, msg in sorted(FLAG_MESSAGES.items()) if int(flags) & bit]
