@@ -12,6 +12,7 @@ STATUS = {
     "NOT_APPROACHING": 3,
     "SINGULAR": 4,
     "OVERFLOW": 5,
+    "ENERGY_INCONSISTENT": 6,
 }
 
 FLAGS = {

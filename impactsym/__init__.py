@@ -12,6 +12,7 @@ on vehicle 1; lower case initial, upper case final).
 """
 
 from .batch import solve_batch
+from .energy import delta_v_from_energy
 from .codes import FLAG_MESSAGES, STATUS_MESSAGES, describe_flags, describe_status
 from .result import Result
 from .scene import Impact, Scene, SceneError, Vehicle, load_scene
@@ -21,5 +22,5 @@ __version__ = "0.1.0"
 
 __all__ = [
     "FLAG_MESSAGES", "STATUS_MESSAGES", "Impact", "Result", "Scene", "SceneError", "Vehicle",
-    "describe_flags", "describe_status", "load_scene", "solve", "solve_batch",
+    "delta_v_from_energy", "describe_flags", "describe_status", "load_scene", "solve", "solve_batch",
 ]

@@ -20,7 +20,9 @@ if getattr(generated, "IMPACTSYM_GENERATED", None) != "impactsym":
         "impactsym's generated kernels (another package named 'generated' shadows it)"
     )
 
-from generated import particle, planar  # noqa: E402
+import numpy as np  # noqa: E402
+
+from generated import delta_v, particle, planar  # noqa: E402
 
 SERIAL_BELOW = 64
 
@@ -57,6 +59,8 @@ KERNELS = {
     ("particle", True): _kernel_set(particle, "particle_critical"),
 }
 
+DELTA_V = _kernel_set(delta_v, "delta_v_from_energy")
+
 MODELS = ("rigid", "particle")
 
 
@@ -65,6 +69,18 @@ def kernel_for(model: str, critical: bool) -> KernelSet:
     if model not in MODELS:
         raise ValueError(f"model: unknown model {model!r} (use one of {', '.join(MODELS)})")
     return KERNELS[(model, bool(critical))]
+
+
+def run_batch(ks: KernelSet, inputs: list[np.ndarray]) -> tuple[dict, np.ndarray, np.ndarray]:
+    """Run a kernel's batch driver over contiguous float64 input arrays of equal
+    length; returns (outputs by name, status, flags) in freshly allocated arrays."""
+    n = inputs[0].shape[0]
+    outs = {name: np.empty(n) for name in ks.outputs}
+    status = np.empty(n, dtype=np.int32)
+    flags = np.empty(n, dtype=np.int32)
+    driver = ks.serial if n < SERIAL_BELOW else ks.batch
+    driver(*inputs, *outs.values(), status, flags)
+    return outs, status, flags
 
 
 def solve_one(model: str, critical: bool, values: dict) -> dict:

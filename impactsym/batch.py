@@ -71,11 +71,7 @@ def solve_batch(columns, model: str = "rigid"):
             continue
         arr = _as_column(columns, name, n)
         inputs.append(np.ascontiguousarray(np.broadcast_to(arr, (n,))))
-    outs = {name: np.empty(n) for name in ks.outputs}
-    status = np.empty(n, dtype=np.int32)
-    flags = np.empty(n, dtype=np.int32)
-    driver = ks.serial if n < _kernels.SERIAL_BELOW else ks.batch
-    driver(*inputs, *outs.values(), status, flags)
+    outs, status, flags = _kernels.run_batch(ks, inputs)
     result = {name: outs[name] if name in outs else _filler(status, n) for name in OUTPUTS}
     result["status"], result["flags"] = status, flags
     if _is_dataframe(columns):

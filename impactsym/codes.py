@@ -15,6 +15,8 @@ status meaning
 4      singular: both bodies fixed, or the impact equations have no unique
        solution for these coefficients
 5      a result overflowed (not finite)
+6      delta-V from energy: the energy loss is negative or not consistent with
+       the coefficients (no real delta-V)
 ====== ======================================================================
 
 ====== ======================================================================
@@ -47,6 +49,8 @@ STATUS_MESSAGES = {
     _codes.STATUS_SINGULAR: "singular impact equations (both bodies fixed, or no unique "
     "impulse for these coefficients)",
     _codes.STATUS_OVERFLOW: "a result is not finite (overflow)",
+    _codes.STATUS_ENERGY_INCONSISTENT: "the energy loss is negative or not consistent with "
+    "the coefficients e, mu and r (no real delta-V)",
 }
 
 FLAG_MESSAGES = {

@@ -1,0 +1,5 @@
+"""``python -m impactsym``: the command line of :mod:`impactsym.cli`."""
+
+from .cli import main
+
+raise SystemExit(main())

@@ -1,0 +1,97 @@
+"""Command line: ``impactsym <command> ...``.
+
+Commands are registered in :data:`COMMANDS` as ``name -> Command``: its
+``add_arguments`` fills the command's sub-parser, its ``run`` takes the parsed
+arguments and returns the exit code.  Any bad input (a scene error, an
+unreadable file, a wrong argument) prints one line ``impactsym: error:
+<reason>`` on stderr and exits with code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from dataclasses import dataclass
+from typing import Callable
+
+from .scene import SceneError
+from .single import solve
+
+__all__ = ["main", "build_parser", "Command", "COMMANDS"]
+
+PROG = "impactsym"
+EXIT_BAD_INPUT = 2
+
+
+@dataclass(frozen=True)
+class Command:
+    """A subcommand: one-line help, how to add its arguments, how to run it."""
+
+    help: str
+    add_arguments: Callable[[argparse.ArgumentParser], None]
+    run: Callable[[argparse.Namespace], int]
+
+
+class UsageError(Exception):
+    """A command-line argument problem (raised instead of argparse's exit)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser that raises :class:`UsageError` instead of printing usage and exiting."""
+
+    def error(self, message: str):
+        raise UsageError(message)
+
+
+def _add_solve(parser: argparse.ArgumentParser) -> None:
+    """Arguments of ``solve``: the scene file and ``--json``."""
+    parser.add_argument("scene", help="scene file (.json or .toml)")
+    parser.add_argument("--json", action="store_true", help="print the result as one JSON object")
+
+
+def _run_solve(args: argparse.Namespace) -> int:
+    """Solve a scene; print JSON (``--json``) or a table."""
+    result = solve(args.scene)
+    if args.json:
+        print(json.dumps(result.to_json_dict(), indent=2, allow_nan=False))
+    else:
+        print(result.table())
+    return 0
+
+
+COMMANDS: dict[str, Command] = {
+    "solve": Command(
+        "solve the impact of a scene (initial motion -> final motion, impulses, energy loss)",
+        _add_solve,
+        _run_solve,
+    ),
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``impactsym`` parser with one sub-parser per entry of :data:`COMMANDS`."""
+    parser = _Parser(prog=PROG, description="Impact phase of planar vehicle collisions.")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for name, command in COMMANDS.items():
+        command.add_arguments(commands.add_parser(name, help=command.help, description=command.help))
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; return the exit code (0 success, 2 bad input)."""
+    try:
+        args = build_parser().parse_args(argv)
+        return COMMANDS[args.command].run(args)
+    except (UsageError, SceneError) as exc:
+        return _fail(str(exc))
+    except OSError as exc:
+        return _fail(f"{exc.filename}: {exc.strerror}" if exc.filename else str(exc))
+    except SystemExit as exc:
+        return exc.code if isinstance(exc.code, int) else 0
+
+
+def _fail(reason: str) -> int:
+    """Print ``impactsym: error: <reason>`` as one line on stderr; return 2."""
+    print(f"{PROG}: error: {' '.join(reason.split())}", file=sys.stderr)
+    return EXIT_BAD_INPUT

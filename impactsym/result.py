@@ -1,0 +1,213 @@
+"""The outcome of one solved scene, as data, JSON and a table for people.
+
+All numbers are in the scene's units: SI (m/s, rad/s, N·s, N·m·s, J) or US
+(ft/s, rad/s, lb·s, ft·lb·s, ft·lb).  Impulses are those on vehicle 1 in the
+impact frame (``Pn`` along n, ``Pt`` along t, ``M`` the moment impulse);
+vehicle 2 receives their opposites.  Energy losses are kinetic energy before
+minus after, so a negative value means the coefficients created energy.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Mapping
+
+from .codes import describe_flags
+from .scene import Scene
+
+__all__ = ["Result", "VehicleResult", "UNIT_LABELS", "scene_warnings"]
+
+UNIT_LABELS = {
+    "SI": {"velocity": "m/s", "yaw_rate": "rad/s", "impulse": "N·s", "moment": "N·m·s", "energy": "J"},
+    "US": {"velocity": "ft/s", "yaw_rate": "rad/s", "impulse": "lb·s", "moment": "ft·lb·s", "energy": "ft·lb"},
+}
+
+_KERNEL_SCALARS = ("Pn", "Pt", "M", "mu", "mu_c", "TL", "TLn", "TLt", "TLm")
+
+
+@dataclass(frozen=True)
+class VehicleResult:
+    """One vehicle at separation.
+
+    ``velocity`` and ``yaw_rate`` are the final motion; ``delta_v`` is final
+    minus initial velocity and ``delta_v_magnitude`` its length.
+    """
+
+    name: str
+    velocity: tuple[float, float]
+    yaw_rate: float
+    delta_v: tuple[float, float]
+    delta_v_magnitude: float
+
+    def to_json_dict(self) -> dict[str, Any]:
+        """The vehicle entry of ``solve --json``."""
+        return {
+            "name": self.name,
+            "velocity": [_finite(value) for value in self.velocity],
+            "yaw_rate": _finite(self.yaw_rate),
+            "delta_v": [_finite(value) for value in self.delta_v],
+            "delta_v_magnitude": _finite(self.delta_v_magnitude),
+        }
+
+
+@dataclass(frozen=True)
+class Result:
+    """A solved scene.
+
+    ``mu`` is the impulse ratio used (equal to ``mu_c`` for a critical
+    scene), ``mu_c`` the critical one.  ``TL = TLn + TLt + TLm`` is the
+    energy loss and its normal, tangential and moment parts.  ``flags`` is the
+    kernel's bit field (see :mod:`impactsym.codes`); ``warnings`` explains it
+    and lists unusual but accepted inputs.
+    """
+
+    model: str
+    units: str
+    critical: bool
+    vehicles: tuple[VehicleResult, VehicleResult]
+    Pn: float
+    Pt: float
+    M: float
+    mu: float
+    mu_c: float
+    TL: float
+    TLn: float
+    TLt: float
+    TLm: float
+    flags: int
+    warnings: list[str] = field(default_factory=list)
+
+    @classmethod
+    def from_kernel(cls, scene: Scene, out: Mapping[str, Any]) -> "Result":
+        """Combine a scene with the output of ``_kernels.solve_one`` (status 0)."""
+        flags = int(out["flags"])
+        return cls(
+            model=scene.model,
+            units=scene.units,
+            critical=scene.impact.critical,
+            vehicles=tuple(
+                _vehicle_result(vehicle, out, number)
+                for number, vehicle in enumerate(scene.vehicles, start=1)
+            ),
+            flags=flags,
+            warnings=describe_flags(flags) + scene_warnings(scene),
+            **{key: float(out[key]) for key in _KERNEL_SCALARS},
+        )
+
+    def to_json_dict(self) -> dict[str, Any]:
+        """The object printed by ``impactsym solve --json`` (conventions.md).
+
+        Non-finite numbers become ``null`` so the output is strict JSON.
+        """
+        return {
+            "model": self.model,
+            "units": self.units,
+            "vehicles": [vehicle.to_json_dict() for vehicle in self.vehicles],
+            "impulse": {"normal": _finite(self.Pn), "tangential": _finite(self.Pt), "moment": _finite(self.M)},
+            "impulse_ratio": _finite(self.mu),
+            "critical_impulse_ratio": _finite(self.mu_c),
+            "energy_loss": {
+                "total": _finite(self.TL),
+                "normal": _finite(self.TLn),
+                "tangential": _finite(self.TLt),
+                "moment": _finite(self.TLm),
+            },
+            "flags": self.flags,
+            "warnings": list(self.warnings),
+        }
+
+    def table(self) -> str:
+        """A plain-text table for people, with unit labels and the warnings.
+
+        The particle model has no yaw: its yaw-rate and moment rows are left out.
+        """
+        one, two = self.vehicles
+        width = max(14, len(one.name) + 2, len(two.name) + 2)
+        lines = [f"{self.model} model, {self.units} units (impulses on vehicle 1, impact frame)", ""]
+        lines.append(f"{'':<28}{one.name:>{width}}{two.name:>{width}}")
+        lines += [f"{label:<28}{_num(a):>{width}}{_num(b):>{width}}" for label, a, b in self._vehicle_rows()]
+        lines.append("")
+        lines += [f"{label:<36}{_num(value):>14}" for label, value in self._impact_rows()]
+        lines.append("")
+        if self.warnings:
+            lines += ["warnings:"] + [f"  - {text}" for text in self.warnings]
+        else:
+            lines.append("warnings: none")
+        return "\n".join(lines)
+
+    def _vehicle_rows(self) -> list[tuple[str, float, float]]:
+        """Per-vehicle table rows: (label with unit, vehicle 1, vehicle 2)."""
+        labels = UNIT_LABELS[self.units]
+        speed, rate = f"[{labels['velocity']}]", f"[{labels['yaw_rate']}]"
+        one, two = self.vehicles
+        rows = [
+            (f"final velocity x {speed}", one.velocity[0], two.velocity[0]),
+            (f"final velocity y {speed}", one.velocity[1], two.velocity[1]),
+            (f"final yaw rate {rate}", one.yaw_rate, two.yaw_rate),
+            (f"delta-V x {speed}", one.delta_v[0], two.delta_v[0]),
+            (f"delta-V y {speed}", one.delta_v[1], two.delta_v[1]),
+            (f"|delta-V| {speed}", one.delta_v_magnitude, two.delta_v_magnitude),
+        ]
+        return [row for row in rows if self.model == "rigid" or "yaw" not in row[0]]
+
+    def _impact_rows(self) -> list[tuple[str, float]]:
+        """Impulse, impulse ratio and energy rows: (label with unit, value)."""
+        labels = UNIT_LABELS[self.units]
+        impulse, moment, energy = (f"[{labels[key]}]" for key in ("impulse", "moment", "energy"))
+        rows = [
+            (f"normal impulse Pn {impulse}", self.Pn),
+            (f"tangential impulse Pt {impulse}", self.Pt),
+            (f"moment impulse M {moment}", self.M),
+            ("impulse ratio mu (critical)" if self.critical else "impulse ratio mu", self.mu),
+            ("critical impulse ratio mu_c", self.mu_c),
+            (f"energy loss TL {energy}", self.TL),
+            (f"  normal TLn {energy}", self.TLn),
+            (f"  tangential TLt {energy}", self.TLt),
+            (f"  moment TLm {energy}", self.TLm),
+        ]
+        return [row for row in rows if self.model == "rigid" or "moment" not in row[0]]
+
+
+def scene_warnings(scene: Scene) -> list[str]:
+    """Warnings about unusual but accepted scene inputs.
+
+    Restitution outside [0, 1], moment restitution outside [-1, 1] (rigid
+    model), a fixed vehicle given a motion, and the scene's own warnings
+    (unknown keys).
+    """
+    impact = scene.impact
+    warnings = []
+    if not 0.0 <= impact.restitution <= 1.0:
+        warnings.append(f"impact.restitution = {impact.restitution:g} is outside [0, 1]")
+    if scene.model == "rigid" and not -1.0 <= impact.moment_restitution <= 1.0:
+        warnings.append(f"impact.moment_restitution = {impact.moment_restitution:g} is outside [-1, 1]")
+    for index, vehicle in enumerate(scene.vehicles):
+        if vehicle.fixed and (vehicle.velocity != (0.0, 0.0) or vehicle.yaw_rate != 0.0):
+            warnings.append(
+                f"vehicles[{index}] ({vehicle.name}) is fixed but given a non-zero velocity or yaw rate"
+            )
+    return warnings + list(scene.warnings)
+
+
+def _vehicle_result(vehicle, out: Mapping[str, Any], number: int) -> VehicleResult:
+    """Final motion and delta-V of vehicle ``number`` (1 or 2) from kernel output."""
+    final = (float(out[f"V{number}x"]), float(out[f"V{number}y"]))
+    delta = (final[0] - vehicle.velocity[0], final[1] - vehicle.velocity[1])
+    return VehicleResult(
+        name=vehicle.name,
+        velocity=final,
+        yaw_rate=float(out[f"W{number}"]),
+        delta_v=delta,
+        delta_v_magnitude=math.hypot(*delta),
+    )
+
+
+def _num(value: float) -> str:
+    """A table cell: six significant digits, negative zero shown as 0."""
+    return f"{value + 0.0:.6g}"
+
+
+def _finite(value: float) -> float | None:
+    """``value``, or ``None`` when it is NaN or infinite (JSON has no such numbers)."""
+    return value if math.isfinite(value) else None

@@ -1,0 +1,433 @@
+"""Scene files: reading, validation and conversion to kernel inputs.
+
+A scene describes one planar two-vehicle impact in the format of
+``conventions.md`` (JSON or TOML, same structure).  Frame: x, y in the scene
+plane, angles counter-clockwise from +x.  ``impact.normal_angle`` is Γ in
+degrees; the normal ``n = (cos Γ, sin Γ)`` points from vehicle 1 toward
+vehicle 2.  ``impact_point`` is the vector from a vehicle's centre of gravity to
+the impact centre, in the scene frame.
+
+Units are consistent sets: ``"SI"`` (kg, m, kg·m², m/s, rad/s) or ``"US"``
+(slug, ft, slug·ft², ft/s, rad/s).  The kernels do not depend on the set; it
+only labels the output.
+
+Validation is strict about values and lenient about keys: a bad value raises
+:class:`SceneError` with one line naming the field path
+(``vehicles[1].mass: must be a positive finite number, got -5``); a key the
+format does not know is kept and reported in :attr:`Scene.warnings`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import numbers
+import sys
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Union
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:
+    import tomli as tomllib
+
+__all__ = ["SceneError", "Vehicle", "Impact", "Scene", "load_scene", "MODELS", "UNITS"]
+
+MODELS = ("rigid", "particle")
+UNITS = ("SI", "US")
+CRITICAL = "critical"
+
+_SCENE_KEYS = ("model", "units", "impact", "vehicles")
+_SCENE_METADATA = ("title", "description", "notes", "comment")
+_IMPACT_KEYS = ("normal_angle", "restitution", "impulse_ratio", "moment_restitution")
+_VEHICLE_KEYS = ("name", "mass", "yaw_inertia", "velocity", "yaw_rate", "impact_point", "fixed")
+
+
+class SceneError(ValueError):
+    """A scene that cannot be solved; the message is one line.
+
+    ``field`` is the path of the offending entry (``"vehicles[1].mass"``) or
+    ``None`` when the problem is not tied to one field (a malformed file, a
+    scene the kernel rejects).
+    """
+
+    def __init__(self, message: str, field: str | None = None):
+        self.field = field
+        text = f"{field}: {message}" if field else message
+        super().__init__(" ".join(text.split()))
+
+
+@dataclass(frozen=True)
+class Vehicle:
+    """One vehicle at first contact.
+
+    ``mass`` [kg | slug] and ``yaw_inertia`` [kg·m² | slug·ft²] are ``None``
+    when not given (a fixed vehicle, or ``yaw_inertia`` in the particle model).
+    ``velocity`` [m/s | ft/s] and ``yaw_rate`` [rad/s] are the initial motion
+    (zero by default for a fixed vehicle); ``impact_point`` [m | ft] is the
+    vector from the centre of gravity to the impact centre, (0, 0) when not
+    needed.  ``fixed`` marks an immovable object (infinite mass and inertia).
+    ``extra`` holds the other keys of the vehicle entry (``heading``,
+    ``final_velocity``, ``crush``, …) as read.
+    """
+
+    name: str
+    mass: float | None
+    yaw_inertia: float | None
+    velocity: tuple[float, float]
+    yaw_rate: float = 0.0
+    impact_point: tuple[float, float] = (0.0, 0.0)
+    fixed: bool = False
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The vehicle entry in scene-file form (``None`` entries left out)."""
+        entry = {
+            "name": self.name,
+            "mass": self.mass,
+            "yaw_inertia": self.yaw_inertia,
+            "velocity": list(self.velocity),
+            "yaw_rate": self.yaw_rate,
+            "impact_point": list(self.impact_point),
+            "fixed": self.fixed,
+        }
+        entry.update(self.extra)
+        return {key: value for key, value in entry.items() if value is not None}
+
+
+@dataclass(frozen=True)
+class Impact:
+    """Impact coefficients.
+
+    ``normal_angle``: Γ in degrees, as written in the scene.  ``restitution``:
+    e.  ``impulse_ratio``: signed μ = Pt/Pn, or ``"critical"`` for μ = μ_c (no
+    sliding at separation).  ``moment_restitution``: e_m (1 gives no moment
+    impulse).
+    """
+
+    normal_angle: float
+    restitution: float
+    impulse_ratio: Union[float, str]
+    moment_restitution: float = 1.0
+
+    @property
+    def critical(self) -> bool:
+        """True when the impulse ratio is the critical one."""
+        return self.impulse_ratio == CRITICAL
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``impact`` table in scene-file form."""
+        return {
+            "normal_angle": self.normal_angle,
+            "restitution": self.restitution,
+            "impulse_ratio": self.impulse_ratio,
+            "moment_restitution": self.moment_restitution,
+        }
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene: model, units, impact coefficients and two vehicles.
+
+    ``source`` is the file it was read from (``None`` for a dict).  ``extra``
+    holds top-level keys other than the four of the format; ``warnings`` lists
+    the keys validation kept but does not know (likely typos).
+    """
+
+    model: str
+    units: str
+    impact: Impact
+    vehicles: tuple[Vehicle, Vehicle]
+    source: Path | None = None
+    extra: dict[str, Any] = field(default_factory=dict)
+    warnings: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        """The scene in scene-file form (what :func:`load_scene` reads back)."""
+        data = {
+            "model": self.model,
+            "units": self.units,
+            "impact": self.impact.to_dict(),
+            "vehicles": [vehicle.to_dict() for vehicle in self.vehicles],
+        }
+        data.update(self.extra)
+        return data
+
+    def to_inputs(self) -> tuple[str, bool, dict[str, float]]:
+        """Kernel inputs ``(model, critical, values)``.
+
+        ``values`` uses the batch names of ``conventions.md``: ``gamma`` is Γ in
+        radians, a fixed vehicle has ``m = I = inf``.  The particle model gets
+        only ``m1 m2 v1x v1y v2x v2y gamma e mu``.  With a critical impulse
+        ratio ``mu`` is a placeholder 0.0, which the kernel ignores.
+        """
+        impact = self.impact
+        values = {
+            "gamma": math.radians(impact.normal_angle),
+            "e": impact.restitution,
+            "mu": 0.0 if impact.critical else float(impact.impulse_ratio),
+        }
+        for number, vehicle in enumerate(self.vehicles, start=1):
+            values.update(_vehicle_inputs(vehicle, number, self.model))
+        if self.model == "rigid":
+            values["e_m"] = impact.moment_restitution
+        return self.model, impact.critical, values
+
+
+def load_scene(source: Union[Scene, Mapping, str, Path]) -> Scene:
+    """Read and validate a scene.
+
+    ``source`` is a :class:`Scene` (validated again), a mapping in scene-file
+    form, or the path of a ``.json`` or ``.toml`` file.  Raises
+    :class:`SceneError` for a bad scene and :class:`OSError` for a file that
+    cannot be read.
+    """
+    if isinstance(source, Scene):
+        return _parse_scene(source.to_dict(), source.source)
+    if isinstance(source, Mapping):
+        return _parse_scene(source, None)
+    if isinstance(source, (str, Path)):
+        path = Path(source)
+        return _parse_scene(_read_file(path), path)
+    raise TypeError(f"load_scene: expected a Scene, a mapping or a path, got {type(source).__name__}")
+
+
+def _read_file(path: Path) -> Any:
+    """The parsed content of a JSON or TOML scene file."""
+    suffix = path.suffix.lower()
+    if suffix not in (".json", ".toml"):
+        raise SceneError(f"{path}: unknown scene file type {suffix or '(none)'!r} (use .json or .toml)")
+    raw = path.read_bytes()
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+    if suffix == ".json":
+        try:
+            return json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise SceneError(f"{path}: invalid JSON: {exc}") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path}: invalid TOML: {exc}") from None
+
+
+def _parse_scene(data: Any, source: Path | None) -> Scene:
+    """Validate a whole scene in scene-file form."""
+    if not isinstance(data, Mapping):
+        where = f"{source}: " if source else ""
+        raise SceneError(f"{where}a scene must be an object (a table of keys), got {_show(data)}")
+    model = _choice(data.get("model", "rigid"), "model", MODELS, "model")
+    units = _choice(_require(data, "units", ""), "units", UNITS, "units")
+    impact_data = _mapping(_require(data, "impact", ""), "impact")
+    impact = _parse_impact(impact_data)
+    vehicles = _parse_vehicles(_require(data, "vehicles", ""), model)
+    extra = {key: data[key] for key in data if key not in _SCENE_KEYS}
+    warnings = _ignored(extra, "", _SCENE_METADATA)
+    warnings += _ignored(impact_data, "impact", _IMPACT_KEYS)
+    for index, vehicle in enumerate(vehicles):
+        warnings += _ignored(vehicle.extra, f"vehicles[{index}]", _VEHICLE_EXTRAS)
+    return Scene(model, units, impact, vehicles, source, extra, tuple(warnings))
+
+
+def _parse_impact(data: Mapping) -> Impact:
+    """Validate the ``impact`` table."""
+    return Impact(
+        normal_angle=_number(_require(data, "normal_angle", "impact"), "impact.normal_angle"),
+        restitution=_number(_require(data, "restitution", "impact"), "impact.restitution"),
+        impulse_ratio=_impulse_ratio(_require(data, "impulse_ratio", "impact")),
+        moment_restitution=_number(data.get("moment_restitution", 1.0), "impact.moment_restitution"),
+    )
+
+
+def _impulse_ratio(value: Any) -> Union[float, str]:
+    """A signed impulse ratio μ, or the string ``"critical"``."""
+    if isinstance(value, str) and value == CRITICAL:
+        return CRITICAL
+    try:
+        return _number(value, "impact.impulse_ratio")
+    except SceneError:
+        raise SceneError(f'must be a finite number or "critical", got {_show(value)}', "impact.impulse_ratio") from None
+
+
+def _parse_vehicles(raw: Any, model: str) -> tuple[Vehicle, Vehicle]:
+    """Validate the list of exactly two vehicles; at most one may be fixed."""
+    if not isinstance(raw, list):
+        raise SceneError(f"must be a list of exactly 2 vehicles, got {_show(raw)}", "vehicles")
+    if len(raw) != 2:
+        raise SceneError(f"must be a list of exactly 2 vehicles, got {len(raw)}", "vehicles")
+    first, second = (_parse_vehicle(entry, index, model) for index, entry in enumerate(raw))
+    if first.fixed and second.fixed:
+        raise SceneError("both vehicles are fixed; at most one may be", "vehicles")
+    return first, second
+
+
+def _parse_vehicle(raw: Any, index: int, model: str) -> Vehicle:
+    """Validate one vehicle entry of the given model.
+
+    A moving vehicle needs ``mass`` and ``velocity``, and in the rigid model
+    also ``yaw_inertia`` and ``impact_point``.  A fixed vehicle needs none of
+    them.  Keys given but not needed are still checked.
+    """
+    path = f"vehicles[{index}]"
+    data = _mapping(raw, path)
+    fixed = _flag(data.get("fixed", False), f"{path}.fixed")
+    rigid = model == "rigid"
+    return Vehicle(
+        name=_name(data.get("name", f"vehicle {index + 1}"), f"{path}.name"),
+        mass=_optional(data, "mass", path, _positive, required=not fixed),
+        yaw_inertia=_optional(data, "yaw_inertia", path, _positive, required=rigid and not fixed),
+        velocity=_optional(data, "velocity", path, _vector, required=not fixed, default=(0.0, 0.0)),
+        yaw_rate=_optional(data, "yaw_rate", path, _number, default=0.0),
+        impact_point=_optional(
+            data, "impact_point", path, _vector, required=rigid and not fixed, default=(0.0, 0.0)
+        ),
+        fixed=fixed,
+        extra=_vehicle_extra(data, path),
+    )
+
+
+def _vehicle_extra(data: Mapping, path: str) -> dict[str, Any]:
+    """The vehicle's other keys; the documented ones have their values checked."""
+    extra = {}
+    for key, value in data.items():
+        if key in _VEHICLE_KEYS:
+            continue
+        check = _VEHICLE_EXTRAS.get(key)
+        extra[key] = check(value, f"{path}.{key}") if check else value
+    return extra
+
+
+def _vehicle_inputs(vehicle: Vehicle, number: int, model: str) -> dict[str, float]:
+    """Batch-named inputs of vehicle ``number`` (1 or 2)."""
+    values = {
+        f"m{number}": math.inf if vehicle.fixed else vehicle.mass,
+        f"v{number}x": vehicle.velocity[0],
+        f"v{number}y": vehicle.velocity[1],
+    }
+    if model == "rigid":
+        values[f"I{number}"] = math.inf if vehicle.fixed else vehicle.yaw_inertia
+        values[f"w{number}"] = vehicle.yaw_rate
+        values[f"r{number}x"] = vehicle.impact_point[0]
+        values[f"r{number}y"] = vehicle.impact_point[1]
+    return values
+
+
+def _ignored(extra: Mapping, path: str, known) -> list[str]:
+    """Warnings for keys of ``extra`` that the format does not document."""
+    prefix = f"{path}." if path else ""
+    return [f"ignored unknown key {prefix}{key}" for key in extra if key not in known]
+
+
+def _require(data: Mapping, key: str, path: str) -> Any:
+    """``data[key]``, or a ``missing`` error naming ``path.key``."""
+    if key not in data:
+        raise SceneError("missing", f"{path}.{key}" if path else key)
+    return data[key]
+
+
+def _optional(data: Mapping, key: str, path: str, check, *, required: bool = False, default: Any = None) -> Any:
+    """``check(data[key])`` when present, an error when required and absent, else ``default``."""
+    if key in data:
+        return check(data[key], f"{path}.{key}")
+    if required:
+        raise SceneError("missing", f"{path}.{key}")
+    return default
+
+
+def _mapping(value: Any, path: str) -> Mapping:
+    """``value`` if it is an object/table."""
+    if not isinstance(value, Mapping):
+        raise SceneError(f"must be an object (a table of keys), got {_show(value)}", path)
+    return value
+
+
+def _choice(value: Any, path: str, allowed: tuple[str, ...], what: str) -> str:
+    """``value`` if it is one of the ``allowed`` strings (exact spelling)."""
+    if not isinstance(value, str) or value not in allowed:
+        options = " or ".join(f'"{option}"' for option in allowed)
+        raise SceneError(f"unknown {what} {_show(value)} (use {options})", path)
+    return value
+
+
+def _is_number(value: Any) -> bool:
+    """True for a real number that is not a bool."""
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
+def _number(value: Any, path: str) -> float:
+    """``value`` as a finite float."""
+    if _is_number(value):
+        try:
+            number = float(value)
+        except OverflowError:
+            number = math.inf
+        if math.isfinite(number):
+            return number
+    raise SceneError(f"must be a finite number, got {_show(value)}", path)
+
+
+def _positive(value: Any, path: str) -> float:
+    """``value`` as a positive finite float (masses, inertias, sizes)."""
+    try:
+        number = _number(value, path)
+    except SceneError:
+        number = math.nan
+    if number > 0.0:
+        return number
+    raise SceneError(f"must be a positive finite number, got {_show(value)}", path)
+
+
+def _vector(value: Any, path: str) -> tuple[float, float]:
+    """``value`` as a pair of finite floats."""
+    if isinstance(value, (list, tuple)) and len(value) == 2:
+        try:
+            return (_number(value[0], path), _number(value[1], path))
+        except SceneError:
+            pass
+        raise SceneError(f"must be a list of 2 finite numbers, got {_show(value)}", path)
+    raise SceneError(f"must be a list of 2 numbers, got {_show(value)}", path)
+
+
+def _flag(value: Any, path: str) -> bool:
+    """``value`` if it is a bool."""
+    if not isinstance(value, bool):
+        raise SceneError(f"must be true or false, got {_show(value)}", path)
+    return value
+
+
+def _name(value: Any, path: str) -> str:
+    """``value`` if it is a non-empty string."""
+    if not isinstance(value, str) or not value.strip():
+        raise SceneError(f"must be a non-empty string, got {_show(value)}", path)
+    return value
+
+
+def _crush(value: Any, path: str) -> Mapping:
+    """A ``crush`` table, kept as read (its entries are checked where used)."""
+    return _mapping(value, path)
+
+
+def _show(value: Any) -> str:
+    """A short, one-line rendering of a scene value for error messages."""
+    if isinstance(value, str):
+        text = repr(value)
+    else:
+        try:
+            text = json.dumps(value)
+        except (TypeError, ValueError):
+            text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+_VEHICLE_EXTRAS = {
+    "length": _positive,
+    "width": _positive,
+    "heading": _number,
+    "final_velocity": _vector,
+    "final_yaw_rate": _number,
+    "crush": _crush,
+}
