@@ -33,6 +33,7 @@ OUTPUTS = (V1x, V1y, W1, V2x, V2y, W2, Pn, Pt, M, mu_used, mu_c, TL, TLn, TLt, T
 r1n, r1t, r2n, r2t = real("r1n r1t r2n r2t")
 Cnn, Cnt, Ctt, Cnm, Ctm, Cmm = real("Cnn Cnt Ctt Cnm Ctm Cmm")
 Knn, Knt, Ktt, hn, ht, am = real("Knn Knt Ktt hn ht am")
+drx, dry, drn, drt, r12, kk, jbar, wa, wb, wc = real("drx dry drn drt r12 kk jbar wa wb wc")
 bn, bt, D, Dc, s, c1, c2 = real("bn bt D Dc s c1 c2")
 
 
@@ -73,9 +74,11 @@ def moment_impulse():
 
 
 def _frame_blocks():
-    """Inverse masses, the normal, relative motion at the impact centre, C."""
+    """Inverse masses, the normal, relative motion at the impact centre, and the
+    pieces of the effective compliance."""
     r1n_, r1t_ = f.to_impact_frame(r1x, r1y)
     r2n_, r2t_ = f.to_impact_frame(r2x, r2y)
+    drn_, drt_ = f.to_impact_frame(drx, dry)
     gx_, gy_ = relative_velocity()
     gn_, gt_ = f.to_impact_frame(gx, gy)
     C = compliance()
@@ -83,30 +86,48 @@ def _frame_blocks():
         Block(
             f.inverse_masses((m1, m2, I1, I2), (k1, k2, j1, j2))
             + f.normal_components()
-            + ((dvx, v2x - v1x), (dvy, v2y - v1y), (wr, w2 - w1)),
+            + ((dvx, v2x - v1x), (dvy, v2y - v1y), (wr, w2 - w1),
+               (drx, r1x - r2x), (dry, r1y - r2y), (r12, r1x * r2y - r1y * r2x)),
             Guard((sp.StrictGreaterThan(k1 + k2, 0), sp.StrictGreaterThan(j1 + j2, 0)),
                   "SINGULAR"),
         ),
-        Block(((r1n, r1n_), (r1t, r1t_), (r2n, r2n_), (r2t, r2t_), (gx, gx_), (gy, gy_))),
+        Block(((r1n, r1n_), (r1t, r1t_), (r2n, r2n_), (r2t, r2t_), (gx, gx_), (gy, gy_),
+               (drn, drn_), (drt, drt_), (kk, k1 + k2), (jbar, j1 * j2 / (j1 + j2)))),
         Block(
-            ((gn, gn_), (gt, gt_), (Cnn, C[0, 0]), (Cnt, C[0, 1]), (Ctt, C[1, 1]),
-             (Cnm, C[0, 2]), (Ctm, C[1, 2]), (Cmm, C[2, 2]),
+            ((gn, gn_), (gt, gt_), (Cnm, C[0, 2]), (Ctm, C[1, 2]),
              # 1 - e_m kept as one factor: e_m = 1 gives exactly no moment impulse.
-             (am, (1 - e_m) / C[2, 2])),
+             (am, (1 - e_m) / C[2, 2]),
+             (wa, e_m * j1), (wb, e_m * j2), (wc, (1 - e_m) * jbar)),
             f.approach_guard(),
         ),
     )
 
 
 def effective_compliance():
-    """K and h of Δ(gn, gt) = -K (Pn, Pt) - h once M is eliminated (am = (1 - e_m)/Cmm)."""
+    """K and h of Δ(gn, gt) = -K (Pn, Pt) - h once M is eliminated.
+
+    Eliminating M gives K = C₂ - am·c cᵀ (C₂ the translational 2x2 block, c the
+    moment column, am = (1 - e_m)/(j1 + j2)). Written that way it cancels badly
+    when a yaw inertia is small (j large). The same matrix, exactly, is
+        K = kk·I + e_m (j1 s1 s1ᵀ + j2 s2 s2ᵀ) + (1 - e_m)·jbar·(s1 - s2)(s1 - s2)ᵀ
+    with s_i = z × r_i and jbar = j1 j2/(j1 + j2): a sum of non-negative terms for
+    0 ≤ e_m ≤ 1 (derive proves the two forms equal)."""
     return {
-        Knn: Cnn - am * Cnm**2,
-        Knt: Cnt - am * Cnm * Ctm,
-        Ktt: Ctt - am * Ctm**2,
+        Knn: kk + wa * r1t**2 + wb * r2t**2 + wc * drt**2,
+        Knt: -(wa * r1n * r1t + wb * r2n * r2t + wc * drn * drt),
+        Ktt: kk + wa * r1n**2 + wb * r2n**2 + wc * drn**2,
         hn: am * Cnm * wr,
         ht: am * Ctm * wr,
     }
+
+
+def effective_determinant():
+    """det K by the Cauchy–Binet formula for kk·I + Σ w_i a_i a_iᵀ:
+    kk² + kk Σ w_i |a_i|² + Σ_{i<k} w_i w_k (a_i × a_k)², where every cross
+    product of s1, s2, s1 - s2 has the magnitude |r1 × r2|. No cancellation for
+    0 ≤ e_m ≤ 1, unlike Knn·Ktt - Knt²."""
+    arms = wa * (r1x**2 + r1y**2) + wb * (r2x**2 + r2y**2) + wc * (drx**2 + dry**2)
+    return kk**2 + kk * arms + r12**2 * (wa * wb + wa * wc + wb * wc)
 
 
 def _impulse_blocks(sticking: bool):
@@ -116,7 +137,7 @@ def _impulse_blocks(sticking: bool):
     # bn = -(dgn + hn) and, for sticking (Δgt = -gt), bt = gt - ht.
     pn_c, pt_c = (Ktt * bn - Knt * bt), (Knn * bt - Knt * bn)
     if sticking:
-        denom, pn, pt = (D, Knn * Ktt - Knt**2), pn_c / D, pt_c / D
+        denom, pn, pt = (D, effective_determinant()), pn_c / D, pt_c / D
     else:
         denom, pn, pt = (D, Knn + mu * Knt), bn / D, mu * bn / D
     return (
@@ -227,6 +248,15 @@ def _six_equation_residuals(got, sticking: bool):
     return res, rel
 
 
+def _small_atoms(sticking: bool):
+    """Atoms for the impulse-level identities, and the lemma that replaces the
+    sticking kernel's det K (Cauchy–Binet form, proven separately)."""
+    atoms = frozenset({Knn, Knt, Ktt, hn, ht, gn, gt})
+    if sticking:
+        return atoms | {D}, {D: Knn * Ktt - Knt**2}
+    return atoms, {}
+
+
 def _six_equations_hold(knl: Kernel, sticking: bool) -> bool:
     """The six equations, in three exact steps:
     1. with (Pn, Pt) free and the kernel's M(Pn, Pt), momentum, angular impulse
@@ -243,8 +273,8 @@ def _six_equations_hold(knl: Kernel, sticking: bool) -> bool:
     step1 = all(_zero(r) for r in res[:6] + res[7:8]) and _zero(
         Gn - (keff[gn] - keff[Knn] * Pn - keff[Knt] * Pt - keff[hn])) and _zero(
         Gt - (keff[gt] - keff[Knt] * Pn - keff[Ktt] * Pt - keff[ht]))
-    small = frozenset({Knn, Knt, Ktt, hn, ht, gn, gt})
-    pn, pt = knl.expanded(Pn, small), knl.expanded(Pt, small)
+    small, lemma = _small_atoms(sticking)
+    pn, pt = (knl.expanded(x, small).xreplace(lemma) for x in (Pn, Pt))
     restitution = (gn - Knn * pn - Knt * pt - hn) + e * gn
     second = (gt - Knt * pn - Ktt * pt - ht) if sticking else pt - mu * pn
     step2 = sp.simplify(restitution) == 0 and sp.simplify(second) == 0
@@ -260,11 +290,16 @@ def _derivation_checks():
     m_sol = moment_impulse()
     C_syms = {Cnn: C[0, 0], Cnt: C[0, 1], Ctt: C[1, 1], Cnm: C[0, 2], Ctm: C[1, 2], Cmm: C[2, 2]}
     dg = -sp.Matrix([[Cnn, Cnt, Cnm], [Cnt, Ctt, Ctm]]) * sp.Matrix([Pn, Pt, m_sol])
-    keff = {k: v.xreplace({am: (1 - e_m) / Cmm}) for k, v in effective_compliance().items()}
+    pieces = {am: (1 - e_m) / Cmm, wa: e_m * j1, wb: e_m * j2, kk: k1 + k2,
+              wc: (1 - e_m) * j1 * j2 / (j1 + j2), drn: r1n - r2n, drt: r1t - r2t}
+    keff = {k: v.xreplace(pieces) for k, v in effective_compliance().items()}
     structured = -sp.Matrix([[keff[Knn], keff[Knt]], [keff[Knt], keff[Ktt]]]) * sp.Matrix([Pn, Pt]) \
         - sp.Matrix([keff[hn], keff[ht]])
     out.append(("rigid: eliminating M (moment restitution) gives the effective K and h",
                 all(_zero((dg[i] - structured[i]).xreplace(C_syms)) for i in range(2))))
+    stick = KERNELS[1]
+    out.append(("rigid: the Cauchy-Binet form of det K equals Knn Ktt - Knt^2",
+                _zero(stick.expanded(D, KEEP) - stick.expanded(Knn * Ktt - Knt**2, KEEP))))
     return out
 
 
@@ -323,10 +358,12 @@ def _sticking_is_sliding_at_critical(stick: Kernel, slide: Kernel) -> bool:
     at = KEEP | {Pn, Pt}
     same_finals = all(sp.expand(stick.expanded(o, at) - slide.expanded(o, at)) == 0
                       for o in (V1x, V1y, W1, V2x, V2y, W2, M))
-    small = frozenset({Knn, Knt, Ktt, bn, bt})
-    crit = {mu: slide.expanded(mu_c, small)}
+    stick_atoms, lemma = _small_atoms(True)
+    slide_atoms = _small_atoms(False)[0] | {bn, bt}
+    crit = {mu: slide.expanded(mu_c, slide_atoms)}
     same_impulse = all(
-        sp.simplify(stick.expanded(o, small) - slide.expanded(o, small).xreplace(crit)) == 0
+        sp.simplify(stick.expanded(o, stick_atoms | {bn, bt}).xreplace(lemma)
+                    - slide.expanded(o, slide_atoms).xreplace(crit)) == 0
         for o in (Pn, Pt))
     return same_finals and same_impulse
 
