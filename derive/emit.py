@@ -11,6 +11,7 @@ naming, no timestamps). Arithmetic is strict IEEE: no fastmath.
 from __future__ import annotations
 
 import hashlib
+from dataclasses import dataclass
 from pathlib import Path
 
 import sympy as sp
@@ -20,8 +21,6 @@ from .codes import FLAGS, STATUS
 from .kernel import Kernel
 
 DERIVE_DIR = Path(__file__).resolve().parent
-JIT = 'njit(cache=True, error_model="numpy")'
-JIT_PARALLEL = 'njit(cache=True, error_model="numpy", parallel=True)'
 
 
 class KernelPrinter(PythonCodePrinter):
@@ -52,12 +51,53 @@ class KernelPrinter(PythonCodePrinter):
         return super()._print_Pow(expr, rational=rational)
 
 
-_printer = KernelPrinter({"fully_qualified_modules": True, "standard": "python3"})
+class Float32Printer(KernelPrinter):
+    """Single precision: every literal a float32, so arithmetic stays in float32."""
+
+    def _print_Integer(self, expr):
+        return f"np.float32({float(expr.p)!r})"
+
+    def _print_Rational(self, expr):
+        return f"np.float32({float(expr.p) / float(expr.q)!r})"
+
+    def _print_Half(self, expr):
+        return "np.float32(0.5)"
+
+
+_SETTINGS = {"fully_qualified_modules": True, "standard": "python3"}
+
+
+@dataclass(frozen=True)
+class Style:
+    """How kernels are printed: the default (strict IEEE float64) is what
+    generated/ holds; the others exist only to be measured against it."""
+
+    jit_options: str
+    printer: KernelPrinter
+    imports: tuple[str, ...] = ("import math",)
+
+    def jit(self, parallel: bool = False) -> str:
+        extra = ", parallel=True" if parallel else ""
+        return f"njit(cache=True, error_model=\"numpy\"{self.jit_options}{extra})"
+
+    def code(self, expr) -> str:
+        """One expression as Python source."""
+        return self.printer.doprint(expr)
+
+
+DEFAULT = Style("", KernelPrinter(_SETTINGS))
+VARIANTS = {
+    "default": DEFAULT,
+    # nnan/ninf let LLVM delete the NaN/inf input checks; reassoc can undo the
+    # ordering derive chose. Measured in benchmarks/, never offered at run time.
+    "fastmath": Style(", fastmath=True", KernelPrinter(_SETTINGS)),
+    "float32": Style("", Float32Printer(_SETTINGS), ("import math", "import numpy as np")),
+}
 
 
 def code(expr) -> str:
-    """One expression as Python source."""
-    return _printer.doprint(expr)
+    """One expression as Python source, default style."""
+    return DEFAULT.code(expr)
 
 
 def source_hash() -> str:
@@ -77,14 +117,14 @@ def header(model_file: str, digest: str) -> str:
     )
 
 
-def _guard_lines(kernel: Kernel, guard, indent: str) -> list[str]:
-    cond = " and ".join(f"({code(c)})" for c in guard.conditions)
+def _guard_lines(kernel: Kernel, guard, indent: str, style: Style) -> list[str]:
+    cond = " and ".join(f"({style.code(c)})" for c in guard.conditions)
     return [f"{indent}if not ({cond}):",
             f"{indent}    return _{kernel.name}_failed({STATUS[guard.status]})"
             f"  # {guard.status}"]
 
 
-def _block_lines(block, temps, indent: str) -> list[str]:
+def _block_lines(block, temps, indent: str, style: Style) -> list[str]:
     """CSE over one block, then its assignments in order."""
     syms = [s for s, _ in block.assigns]
     own = set(syms)
@@ -92,30 +132,30 @@ def _block_lines(block, temps, indent: str) -> list[str]:
         if expr.free_symbols & own:
             raise ValueError(f"a formula uses a symbol of its own block: {expr}")
     replacements, reduced = sp.cse([expr for _, expr in block.assigns], symbols=temps)
-    lines = [f"{indent}{t} = {code(x)}" for t, x in replacements]
-    lines += [f"{indent}{s} = {code(x)}" for s, x in zip(syms, reduced)]
+    lines = [f"{indent}{t} = {style.code(x)}" for t, x in replacements]
+    lines += [f"{indent}{s} = {style.code(x)}" for s, x in zip(syms, reduced)]
     return lines
 
 
-def scene_function(kernel: Kernel) -> str:
+def scene_function(kernel: Kernel, style: Style = DEFAULT) -> str:
     """The per-scene function: checks, blocks with guards, flags, finite check."""
     args = ", ".join(str(s) for s in kernel.inputs)
     outs = ", ".join(str(s) for s in kernel.outputs)
     ind = "    "
-    lines = [f"@{JIT}", f"def {kernel.name}({args}):",
+    lines = [f"@{style.jit()}", f"def {kernel.name}({args}):",
              f'{ind}"""{kernel.doc}', "",
              f"{ind}Returns ({outs}, status, flags); a failed row has NaN outputs.",
              f'{ind}"""']
     for guard in kernel.checks:
-        lines += _guard_lines(kernel, guard, ind)
+        lines += _guard_lines(kernel, guard, ind, style)
     temps = sp.numbered_symbols("_t")
     for block in kernel.blocks:
-        lines += _block_lines(block, temps, ind)
+        lines += _block_lines(block, temps, ind, style)
         if block.guard is not None:
-            lines += _guard_lines(kernel, block.guard, ind)
+            lines += _guard_lines(kernel, block.guard, ind, style)
     lines.append(f"{ind}flags = 0")
     for name, conditions in kernel.flags:
-        cond = " or ".join(f"({code(c)})" for c in conditions)
+        cond = " or ".join(f"({style.code(c)})" for c in conditions)
         lines += [f"{ind}if {cond}:", f"{ind}    flags |= {FLAGS[name]}  # {name}"]
     total = " + ".join(str(s) for s in kernel.outputs)
     lines += [f"{ind}if not math.isfinite({total}):",
@@ -124,21 +164,21 @@ def scene_function(kernel: Kernel) -> str:
     return "\n".join(lines) + "\n"
 
 
-def failed_function(kernel: Kernel) -> str:
+def failed_function(kernel: Kernel, style: Style = DEFAULT) -> str:
     """NaN outputs with a status: the return value of a row that is not solved."""
     nans = ", ".join(["math.nan"] * len(kernel.outputs))
-    return (f"@{JIT}\ndef _{kernel.name}_failed(status):\n"
+    return (f"@{style.jit()}\ndef _{kernel.name}_failed(status):\n"
             f"    return ({nans}, status, 0)\n")
 
 
-def batch_function(kernel: Kernel, parallel: bool) -> str:
+def batch_function(kernel: Kernel, parallel: bool, style: Style = DEFAULT) -> str:
     """The batch driver over struct-of-arrays inputs into caller-owned outputs."""
     name = f"{kernel.name}_batch" + ("" if parallel else "_serial")
     ins = [str(s) for s in kernel.inputs]
     outs = [f"out_{s}" for s in kernel.output_names()] + ["out_status", "out_flags"]
     loop = "prange" if parallel else "range"
     results = ", ".join(f"_r{i}" for i in range(len(outs)))
-    lines = [f"@{JIT_PARALLEL if parallel else JIT}",
+    lines = [f"@{style.jit(parallel)}",
              f"def {name}({', '.join(ins + outs)}):",
              f'    """{"Parallel" if parallel else "Serial"} batch of `{kernel.name}`: '
              'one row per index, outputs written in place."""',
@@ -148,16 +188,17 @@ def batch_function(kernel: Kernel, parallel: bool) -> str:
     return "\n".join(lines) + "\n"
 
 
-def render_module(model_file: str, doc: str, kernels, digest: str) -> str:
+def render_module(model_file: str, doc: str, kernels, digest: str,
+                  style: Style = DEFAULT) -> str:
     """A whole generated module as text."""
     parts = [header(model_file, digest), f'"""{doc}"""', "",
-             "import math", "", "from numba import njit, prange", ""]
+             *style.imports, "", "from numba import njit, prange", ""]
     for knl in kernels:
         parts += [f"{knl.name.upper()}_INPUTS = {tuple(str(s) for s in knl.inputs)!r}",
                   f"{knl.name.upper()}_OUTPUTS = {knl.output_names()!r}", ""]
     for knl in kernels:
-        parts += ["", failed_function(knl), "", scene_function(knl), "",
-                  batch_function(knl, parallel=True), "", batch_function(knl, parallel=False)]
+        parts += ["", failed_function(knl, style), "", scene_function(knl, style), "",
+                  batch_function(knl, True, style), "", batch_function(knl, False, style)]
     return "\n".join(parts).rstrip("\n") + "\n"
 
 

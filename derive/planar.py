@@ -214,6 +214,24 @@ def kernel(sticking: bool) -> Kernel:
 KERNELS = (kernel(sticking=False), kernel(sticking=True))
 
 
+def ke_difference_kernel() -> Kernel:
+    """The sliding kernel with TL as the naive kinetic-energy difference
+    T_before - T_after (finite masses only). Not emitted to generated/: it
+    exists so benchmarks/ can measure what the work form saves."""
+    base = kernel(sticking=False)
+
+    def energy(vx, vy, w, m, inertia):
+        return m * (vx**2 + vy**2) / 2 + inertia * w**2 / 2
+
+    naive = (energy(v1x, v1y, w1, m1, I1) + energy(v2x, v2y, w2, m2, I2)
+             - energy(V1x, V1y, W1, m1, I1) - energy(V2x, V2y, W2, m2, I2))
+    blocks = tuple(Block(((TL, naive),)) if block.assigns[0][0] == TL else block
+                   for block in base.blocks)
+    return Kernel(name="rigid_ke_difference", doc=base.doc + " TL as a kinetic-energy difference.",
+                  inputs=base.inputs, checks=base.checks, blocks=blocks,
+                  outputs=base.outputs, flags=base.flags)
+
+
 # ---------------------------------------------------------------- proofs
 
 KEEP = frozenset({k1, k2, j1, j2, nx, ny})
