@@ -60,7 +60,7 @@ KERNELS = (
         name="delta_v_from_energy",
         doc="Delta-V of each vehicle from the energy loss TL (seed eqs 27-29; e_m = 1).",
         inputs=INPUTS,
-        checks=(finite_inputs((r1x, r1y, r2x, r2y, gamma, e, mu, r, TL_in)),
+        checks=(finite_inputs((r1x, r1y, r2x, r2y, gamma, e, mu, r, TL_in), (m1, m2, I1, I2)),
                 positive_or_fixed((m1, m2, I1, I2)),
                 Guard((sp.GreaterThan(TL_in, 0), sp.StrictGreaterThan(1 + e, 0)),
                       "ENERGY_INCONSISTENT")),

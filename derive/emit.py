@@ -29,6 +29,9 @@ class KernelPrinter(PythonCodePrinter):
     def _print_IsFinite(self, expr):
         return f"math.isfinite({self._print(expr.args[0])})"
 
+    def _print_NotNaN(self, expr):
+        return f"not math.isnan({self._print(expr.args[0])})"
+
     def _print_Integer(self, expr):
         return f"{float(expr.p)!r}"
 

@@ -87,9 +87,15 @@ class IsFinite(sp.Function):
     """`math.isfinite(x)` as a SymPy function, for input guards."""
 
 
-def finite_inputs(symbols) -> Guard:
-    """Guard: every one of `symbols` is a finite number (not NaN, not inf)."""
-    return Guard(tuple(IsFinite(s) for s in symbols), "NONFINITE_INPUT")
+class NotNaN(sp.Function):
+    """`not math.isnan(x)` as a SymPy function, for input guards."""
+
+
+def finite_inputs(symbols, masses=()) -> Guard:
+    """Guard: every one of `symbols` is a finite number and no mass or inertia is
+    NaN (a mass may be +inf: a fixed body)."""
+    return Guard(tuple(IsFinite(s) for s in symbols) + tuple(NotNaN(m) for m in masses),
+                 "NONFINITE_INPUT")
 
 
 def positive_or_fixed(symbols) -> Guard:

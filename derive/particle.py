@@ -137,7 +137,7 @@ def kernel(sticking: bool) -> Kernel:
         doc=doc,
         inputs=INPUTS,
         checks=(
-            finite_inputs((v1x, v1y, v2x, v2y, gamma, e) + (() if sticking else (mu,))),
+            finite_inputs((v1x, v1y, v2x, v2y, gamma, e) + (() if sticking else (mu,)), (m1, m2)),
             positive_or_fixed((m1, m2)),
         ),
         blocks=_kernel_blocks(sticking) + (tolerances,),

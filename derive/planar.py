@@ -198,7 +198,7 @@ def kernel(sticking: bool) -> Kernel:
         doc=doc,
         inputs=INPUTS,
         checks=(
-            finite_inputs(scalars + (() if sticking else (mu,))),
+            finite_inputs(scalars + (() if sticking else (mu,)), (m1, m2, I1, I2)),
             positive_or_fixed((m1, m2, I1, I2)),
             # A fixed body has infinite mass AND inertia, or neither.
             Guard((sp.Eq(IsFinite(m1), IsFinite(I1)), sp.Eq(IsFinite(m2), IsFinite(I2))),
