@@ -13,6 +13,8 @@ STATUS = {
     "SINGULAR": 4,
     "OVERFLOW": 5,
     "ENERGY_INCONSISTENT": 6,
+    "INVERSE_E_TOO_SMALL": 7,
+    "INVERSE_EM_TOO_SMALL": 8,
 }
 
 FLAGS = {

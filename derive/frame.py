@@ -71,7 +71,7 @@ def approach_guard() -> Guard:
 ROUNDING = sp.Rational(1, 2**48)
 
 
-def physics_flags(energy_parts, work_terms):
+def physics_flags(energy_parts, work_terms, mu_used=mu_used):
     """The block of flag tolerances and the conditions for the flag bits of
     conventions.md on a solved row.
 

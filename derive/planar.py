@@ -241,11 +241,15 @@ def _zero(expr) -> bool:
     return f.reduce_unit_normal(expr) == 0
 
 
-def _six_equation_residuals(got, sticking: bool):
-    """Residuals of the six equations (conventions.md) in the scene frame."""
+def six_equation_residuals(got, sticking: bool):
+    """Residuals of the six equations (conventions.md) in the scene frame.
+
+    `got` maps finals (and P, M) to expressions; initials not in `got` stay
+    symbols (the forward problem), or are expressions too (the inverse)."""
     px, py = got[Px], got[Py]
-    u1 = (v1x - w1 * r1y, v1y + w1 * r1x)
-    u2 = (v2x - w2 * r2y, v2y + w2 * r2x)
+    v1x_, v1y_, w1_, v2x_, v2y_, w2_ = (got.get(s, s) for s in (v1x, v1y, w1, v2x, v2y, w2))
+    u1 = (v1x_ - w1_ * r1y, v1y_ + w1_ * r1x)
+    u2 = (v2x_ - w2_ * r2y, v2y_ + w2_ * r2x)
     U1 = (got[V1x] - got[W1] * r1y, got[V1y] + got[W1] * r1x)
     U2 = (got[V2x] - got[W2] * r2y, got[V2y] + got[W2] * r2x)
     n, t = (nx, ny), (-ny, nx)
@@ -255,10 +259,10 @@ def _six_equation_residuals(got, sticking: bool):
 
     rel = (U2[0] - U1[0], U2[1] - U1[1])
     res = [
-        got[V1x] - v1x - k1 * px, got[V1y] - v1y - k1 * py,
-        got[V2x] - v2x + k2 * px, got[V2y] - v2y + k2 * py,
-        got[W1] - w1 - j1 * (r1x * py - r1y * px + got[M]),
-        got[W2] - w2 + j2 * (r2x * py - r2y * px + got[M]),
+        got[V1x] - v1x_ - k1 * px, got[V1y] - v1y_ - k1 * py,
+        got[V2x] - v2x_ + k2 * px, got[V2y] - v2y_ + k2 * py,
+        got[W1] - w1_ - j1 * (r1x * py - r1y * px + got[M]),
+        got[W2] - w2_ + j2 * (r2x * py - r2y * px + got[M]),
         dot(n, rel) + e * dot(n, (u2[0] - u1[0], u2[1] - u1[1])),
         (got[W2] - got[W1]) * (1 - e_m) - e_m * got[M] * (j1 + j2),
         dot(t, rel) if sticking else dot(t, (px, py)) - mu * dot(n, (px, py)),
@@ -285,7 +289,7 @@ def _six_equations_hold(knl: Kernel, sticking: bool) -> bool:
     3. so the scene-frame restitution and ratio residuals vanish."""
     at = KEEP | {Pn, Pt}
     free = {sym: knl.expanded(sym, at) for sym in knl.outputs + (Px, Py)}
-    res, rel = _six_equation_residuals(free, sticking)
+    res, rel = six_equation_residuals(free, sticking)
     Gn, Gt = f.to_impact_frame(*rel)
     keff = {sym: knl.expanded(sym, KEEP) for sym in (Knn, Knt, Ktt, hn, ht, gn, gt)}
     step1 = all(_zero(r) for r in res[:6] + res[7:8]) and _zero(
@@ -337,7 +341,7 @@ def _kernel_checks(knl: Kernel, sticking: bool, sliding: Kernel | None = None):
     # Lemma: for ANY impulse (Pn, Pt, M), the kinetic energy lost is the work of
     # the components on the mean relative velocity (conventions.md, Energy).
     free = {sym: knl.expanded(sym, KEEP | {Pn, Pt, M}) for sym in (V1x, V1y, W1, V2x, V2y, W2)}
-    _, rel = _six_equation_residuals({**free, Px: knl.expanded(Px, KEEP | {Pn, Pt}),
+    _, rel = six_equation_residuals({**free, Px: knl.expanded(Px, KEEP | {Pn, Pt}),
                                       Py: knl.expanded(Py, KEEP | {Pn, Pt}), M: M}, sticking)
     Gn, Gt = f.to_impact_frame(*rel)
     ke = [(vx**2 + vy**2) / (2 * k) + w**2 / (2 * j)

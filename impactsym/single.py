@@ -6,21 +6,17 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Union
 
+from generated.codes import STATUS_NOT_APPROACHING
+
 from . import _kernels
-from .codes import STATUS_MESSAGES
+from .codes import describe_status
 from .result import Result
 from .scene import Scene, SceneError, load_scene
 
-__all__ = ["solve"]
+__all__ = ["solve", "status_reason"]
 
-STATUS_NOT_APPROACHING = 3
-STATUS_SINGULAR = 4
-
-_REASONS = {
-    STATUS_NOT_APPROACHING: (
-        "vehicles are not approaching at the impact centre (check normal_angle: n must point "
-        "from vehicle 1 toward vehicle 2, and the velocities)"
-    ),
+_HINTS = {
+    STATUS_NOT_APPROACHING: "check impact.normal_angle and the vehicles' velocities and yaw rates",
 }
 
 
@@ -34,17 +30,13 @@ def solve(scene: Union[Scene, Mapping, str, Path]) -> Result:
     scene = load_scene(scene)
     model, critical, values = scene.to_inputs()
     out = _kernels.solve_one(model, critical, values)
-    status = int(out["status"])
-    if status != 0:
-        raise SceneError(status_reason(status))
+    if out["status"] != 0:
+        raise SceneError(status_reason(out["status"]))
     return Result.from_kernel(scene, out)
 
 
 def status_reason(status: int) -> str:
-    """A one-line explanation of a non-zero kernel status."""
-    if status in _REASONS:
-        return _REASONS[status]
-    message = STATUS_MESSAGES.get(status, f"unknown kernel status {status}")
-    if status == STATUS_SINGULAR:
-        message += " (the impulse equations have no unique solution for these masses and inertias)"
-    return f"cannot solve the scene: {message}"
+    """A one-line explanation of a non-zero kernel status, with a hint where one helps."""
+    reason = f"cannot solve the scene: {describe_status(status)}"
+    hint = _HINTS.get(status)
+    return f"{reason}; {hint}" if hint else reason

@@ -107,7 +107,7 @@ def _repeat_rows(columns, reps):
 
 def _mu_c(columns, model):
     """Reference mu_c of every row (float64)."""
-    return np.array([float(R.mu_critical(R.row_of(dict(columns, mu=0.0), i), model))
+    return np.array([float(R.mu_critical(R.row_of(dict(columns, mu="critical"), i), model))
                      for i in range(R.n_rows(columns))])
 
 
