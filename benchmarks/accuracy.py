@@ -477,8 +477,11 @@ def markdown(methods, timing, errors, sets, args) -> str:
     lines += ["", "## Machine", "",
               f"{platform.machine()}, {os.cpu_count()} CPUs, numba {numba.__version__} with "
               f"{numba.get_num_threads()} threads, NumPy {np.__version__}, Python "
-              f"{platform.python_version()}. Warm-up (first call, includes JIT compile): "
-              + ", ".join(f"{m.label} {timing[m.key]['warmup_s']:.1f} s" for m in methods)
+              f"{platform.python_version()}. First call ({sets['realistic'].n} rows, includes the JIT "
+              "compile; the variants compile from scratch every run, the default loads numba's "
+              "cache): "
+              + ", ".join(f"{m.label} {timing[m.key].get('first_call_s', math.nan):.2f} s"
+                          for m in methods)
               + ". The numba kernels use every thread (prange); `numpy.linalg.solve` and the "
               "lambdified NumPy code run on one."]
     return "\n".join(lines) + "\n"
@@ -590,15 +593,20 @@ def main(args) -> int:
     log("rendering and importing variants ...")
     methods = build_methods()
     errors: dict[str, dict[str, SetErrors]] = {}
+    first_call = {}
     for m in methods:
         errors[m.key] = {}
         for s in SET_NAMES:
+            t0 = time.perf_counter()
             outs = m.bind(scene_sets[s].columns)()
+            first_call.setdefault(m.key, time.perf_counter() - t0)
             errors[m.key][s] = set_errors(outs, scene_sets[s])
         log(f"  errors {m.label}: realistic {_fmt(errors[m.key]['realistic'].worst())}, "
             f"stress {_fmt(errors[m.key]['stress'].worst(), errors[m.key]['stress'].fails)}")
     log(f"timing n = {args.n} ...")
     timing = time_methods(methods, tile(scene_sets["realistic"].columns, args.n), args.repeat, log)
+    for key, seconds in first_call.items():
+        timing[key]["first_call_s"] = seconds
     args.out.mkdir(parents=True, exist_ok=True)
     text = markdown(methods, timing, errors, scene_sets, args)
     (args.out / "accuracy.md").write_text(text)

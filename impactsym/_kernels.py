@@ -22,7 +22,7 @@ if getattr(generated, "IMPACTSYM_GENERATED", None) != "impactsym":
 
 import numpy as np  # noqa: E402
 
-from generated import delta_v, particle, planar  # noqa: E402
+from generated import delta_v, inverse, particle, planar  # noqa: E402
 
 SERIAL_BELOW = 64
 
@@ -61,14 +61,31 @@ KERNELS = {
 
 DELTA_V = _kernel_set(delta_v, "delta_v_from_energy")
 
+INVERSE = {
+    "rigid": _kernel_set(inverse, "rigid_inverse"),
+    "particle": _kernel_set(inverse, "particle_inverse"),
+}
+INVERSE_OUTPUTS = ("v1x", "v1y", "w1", "v2x", "v2y", "w2", "Pn", "Pt", "M",
+                   "mu_c", "TL", "TLn", "TLt", "TLm")
+
 MODELS = ("rigid", "particle")
 
 
-def kernel_for(model: str, critical: bool) -> KernelSet:
-    """The kernel for a model name and impulse-ratio mode; ValueError if unknown."""
+def _check_model(model: str) -> None:
     if model not in MODELS:
         raise ValueError(f"model: unknown model {model!r} (use one of {', '.join(MODELS)})")
+
+
+def kernel_for(model: str, critical: bool) -> KernelSet:
+    """The forward kernel for a model name and impulse-ratio mode; ValueError if unknown."""
+    _check_model(model)
     return KERNELS[(model, bool(critical))]
+
+
+def inverse_kernel_for(model: str) -> KernelSet:
+    """The inverse kernel (pre-impact from post-impact) of a model."""
+    _check_model(model)
+    return INVERSE[model]
 
 
 def run_batch(ks: KernelSet, inputs: list[np.ndarray]) -> tuple[dict, np.ndarray, np.ndarray]:
@@ -83,17 +100,23 @@ def run_batch(ks: KernelSet, inputs: list[np.ndarray]) -> tuple[dict, np.ndarray
     return outs, status, flags
 
 
-def solve_one(model: str, critical: bool, values: dict) -> dict:
-    """Solve one scene without compiling: `values` maps input names to floats
-    (gamma in radians; `mu` is ignored and may be absent when `critical`).
-    Returns every name of `OUTPUTS` plus int `status` and `flags`."""
-    ks = kernel_for(model, critical)
-    args = [float(values.get(name, 0.0)) if name == "mu" and critical else float(values[name])
-            for name in ks.inputs]
-    *outs, status, flags = ks.scene.py_func(*args)
+def run_one(ks: KernelSet, values: dict, outputs: tuple[str, ...]) -> dict:
+    """Run one scene through a kernel's plain-Python twin (no compile).
+
+    Returns every name of `outputs` (0.0 for a quantity the kernel's model does
+    not have, NaN on a failed row) plus int `status` and `flags`."""
+    *outs, status, flags = ks.scene.py_func(*[float(values[name]) for name in ks.inputs])
     result = dict(zip(ks.outputs, outs))
-    for name in OUTPUTS:
+    for name in outputs:
         if name not in result:
             result[name] = 0.0 if status == 0 else math.nan
     result["status"], result["flags"] = int(status), int(flags)
     return result
+
+
+def solve_one(model: str, critical: bool, values: dict) -> dict:
+    """Solve one scene without compiling: `values` maps input names to floats
+    (gamma in radians; `mu` is ignored and may be absent when `critical`).
+    Returns every name of `OUTPUTS` plus int `status` and `flags`."""
+    values = {"mu": 0.0, **values} if critical else values
+    return run_one(kernel_for(model, critical), values, OUTPUTS)

@@ -45,6 +45,25 @@ def _critical_mode(columns) -> bool:
     return isinstance(mu, str) and mu == "critical"
 
 
+def run_columns(ks: _kernels.KernelSet, columns, outputs, placeholders=()):
+    """Validate `columns` for kernel `ks`, run it, and return `outputs` plus
+    `status` and `flags` as the same kind of mapping (dict or DataFrame).
+    Inputs named in `placeholders` are not read (the kernel ignores them)."""
+    names = [k for k in ks.inputs if k not in placeholders]
+    n = _row_count(columns, names)
+    inputs = [np.zeros(n) if name in placeholders else
+              np.ascontiguousarray(np.broadcast_to(_as_column(columns, name, n), (n,)))
+              for name in ks.inputs]
+    outs, status, flags = _kernels.run_batch(ks, inputs)
+    result = {name: outs[name] if name in outs else _filler(status, n) for name in outputs}
+    result["status"], result["flags"] = status, flags
+    if _is_dataframe(columns):
+        import pandas as pd
+
+        return pd.DataFrame(result, index=columns.index)
+    return result
+
+
 def solve_batch(columns, model: str = "rigid"):
     """Solve one scene per row with the generated kernels.
 
@@ -62,23 +81,7 @@ def solve_batch(columns, model: str = "rigid"):
     """
     critical = _critical_mode(columns)
     ks = _kernels.kernel_for(model, critical)
-    names = [k for k in ks.inputs if not (critical and k == "mu")]
-    n = _row_count(columns, names)
-    inputs = []
-    for name in ks.inputs:
-        if critical and name == "mu":
-            inputs.append(np.zeros(n))
-            continue
-        arr = _as_column(columns, name, n)
-        inputs.append(np.ascontiguousarray(np.broadcast_to(arr, (n,))))
-    outs, status, flags = _kernels.run_batch(ks, inputs)
-    result = {name: outs[name] if name in outs else _filler(status, n) for name in OUTPUTS}
-    result["status"], result["flags"] = status, flags
-    if _is_dataframe(columns):
-        import pandas as pd
-
-        return pd.DataFrame(result, index=columns.index)
-    return result
+    return run_columns(ks, columns, OUTPUTS, ("mu",) if critical else ())
 
 
 def _filler(status: np.ndarray, n: int) -> np.ndarray:
@@ -87,4 +90,3 @@ def _filler(status: np.ndarray, n: int) -> np.ndarray:
     out = np.zeros(n)
     out[status != 0] = np.nan
     return out
-

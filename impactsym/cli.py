@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from .scene import SceneError
+from .inverse import invert
 from .single import solve
 
 __all__ = ["main", "build_parser", "Command", "COMMANDS"]
@@ -50,14 +51,23 @@ def _add_solve(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print the result as one JSON object")
 
 
-def _run_solve(args: argparse.Namespace) -> int:
-    """Solve a scene; print JSON (``--json``) or a table."""
-    result = solve(args.scene)
-    if args.json:
+def _print_result(result, as_json: bool) -> int:
+    """Print a result as JSON or as a table; return exit code 0."""
+    if as_json:
         print(json.dumps(result.to_json_dict(), indent=2, allow_nan=False))
     else:
         print(result.table())
     return 0
+
+
+def _run_solve(args: argparse.Namespace) -> int:
+    """Solve a scene; print JSON (``--json``) or a table."""
+    return _print_result(solve(args.scene), args.json)
+
+
+def _run_invert(args: argparse.Namespace) -> int:
+    """Recover the pre-impact motion of an inverse scene; print JSON or a table."""
+    return _print_result(invert(args.scene), args.json)
 
 
 COMMANDS: dict[str, Command] = {
@@ -65,6 +75,11 @@ COMMANDS: dict[str, Command] = {
         "solve the impact of a scene (initial motion -> final motion, impulses, energy loss)",
         _add_solve,
         _run_solve,
+    ),
+    "invert": Command(
+        "recover the pre-impact motion from the post-impact motion and e, mu, e_m",
+        _add_solve,
+        _run_invert,
     ),
 }
 

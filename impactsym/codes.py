@@ -17,6 +17,10 @@ status meaning
 5      a result overflowed (not finite)
 6      delta-V from energy: the energy loss is negative or not consistent with
        the coefficients (no real delta-V)
+7      inverse: restitution e is zero or below 2^-20, so the final velocities do
+       not determine the normal approach speed
+8      inverse: moment restitution |e_m| is zero or below 2^-20, so the final
+       yaw rates do not determine the initial relative yaw rate
 ====== ======================================================================
 
 ====== ======================================================================
@@ -51,6 +55,13 @@ STATUS_MESSAGES = {
     _codes.STATUS_OVERFLOW: "a result is not finite (overflow)",
     _codes.STATUS_ENERGY_INCONSISTENT: "the energy loss is negative or not consistent with "
     "the coefficients e, mu and r (no real delta-V)",
+    _codes.STATUS_INVERSE_E_TOO_SMALL: "restitution e is zero or below 2^-20: the final "
+    "velocities do not determine the normal approach speed (e appears in the denominator); "
+    "give the pre-impact headings (impactsym reconstruct) or the energy loss "
+    "(impactsym.delta_v_from_energy) instead",
+    _codes.STATUS_INVERSE_EM_TOO_SMALL: "moment restitution e_m is zero or below 2^-20 in "
+    "magnitude: the final yaw rates do not determine the initial relative yaw rate; give the "
+    "pre-impact yaw rates (impactsym reconstruct) or use e_m = 1 (no moment impulse)",
 }
 
 FLAG_MESSAGES = {

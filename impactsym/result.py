@@ -77,6 +77,7 @@ class Result:
     TLm: float
     flags: int
     warnings: list[str] = field(default_factory=list)
+    direction: str = "forward"
 
     @classmethod
     def from_kernel(cls, scene: Scene, out: Mapping[str, Any]) -> "Result":
@@ -141,10 +142,11 @@ class Result:
         labels = UNIT_LABELS[self.units]
         speed, rate = f"[{labels['velocity']}]", f"[{labels['yaw_rate']}]"
         one, two = self.vehicles
+        when = "final" if self.direction == "forward" else "initial"
         rows = [
-            (f"final velocity x {speed}", one.velocity[0], two.velocity[0]),
-            (f"final velocity y {speed}", one.velocity[1], two.velocity[1]),
-            (f"final yaw rate {rate}", one.yaw_rate, two.yaw_rate),
+            (f"{when} velocity x {speed}", one.velocity[0], two.velocity[0]),
+            (f"{when} velocity y {speed}", one.velocity[1], two.velocity[1]),
+            (f"{when} yaw rate {rate}", one.yaw_rate, two.yaw_rate),
             (f"delta-V x {speed}", one.delta_v[0], two.delta_v[0]),
             (f"delta-V y {speed}", one.delta_v[1], two.delta_v[1]),
             (f"|delta-V| {speed}", one.delta_v_magnitude, two.delta_v_magnitude),

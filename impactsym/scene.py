@@ -176,21 +176,29 @@ class Scene:
         return self.model, impact.critical, values
 
 
-def load_scene(source: Union[Scene, Mapping, str, Path]) -> Scene:
+KINDS = ("forward", "inverse", "reconstruct")
+
+
+def load_scene(source: Union[Scene, Mapping, str, Path], kind: str = "forward") -> Scene:
     """Read and validate a scene.
 
     ``source`` is a :class:`Scene` (validated again), a mapping in scene-file
-    form, or the path of a ``.json`` or ``.toml`` file.  Raises
-    :class:`SceneError` for a bad scene and :class:`OSError` for a file that
-    cannot be read.
+    form, or the path of a ``.json`` or ``.toml`` file.  ``kind`` says what the
+    scene is for: ``"forward"`` (initial motion given), ``"inverse"`` (final
+    motion given instead: ``final_velocity``, ``final_yaw_rate``) or
+    ``"reconstruct"`` (final motion and pre-impact ``heading``; the impact needs
+    only ``normal_angle``).  Raises :class:`SceneError` for a bad scene and
+    :class:`OSError` for a file that cannot be read.
     """
+    if kind not in KINDS:
+        raise ValueError(f"kind: unknown scene kind {kind!r} (use one of {', '.join(KINDS)})")
     if isinstance(source, Scene):
-        return _parse_scene(source.to_dict(), source.source)
+        return _parse_scene(source.to_dict(), source.source, kind)
     if isinstance(source, Mapping):
-        return _parse_scene(source, None)
+        return _parse_scene(source, None, kind)
     if isinstance(source, (str, Path)):
         path = Path(source)
-        return _parse_scene(_read_file(path), path)
+        return _parse_scene(_read_file(path), path, kind)
     raise TypeError(f"load_scene: expected a Scene, a mapping or a path, got {type(source).__name__}")
 
 
@@ -215,7 +223,7 @@ def _read_file(path: Path) -> Any:
         raise SceneError(f"{path}: invalid TOML: {exc}") from None
 
 
-def _parse_scene(data: Any, source: Path | None) -> Scene:
+def _parse_scene(data: Any, source: Path | None, kind: str) -> Scene:
     """Validate a whole scene in scene-file form."""
     if not isinstance(data, Mapping):
         where = f"{source}: " if source else ""
@@ -223,8 +231,8 @@ def _parse_scene(data: Any, source: Path | None) -> Scene:
     model = _choice(data.get("model", "rigid"), "model", MODELS, "model")
     units = _choice(_require(data, "units", ""), "units", UNITS, "units")
     impact_data = _mapping(_require(data, "impact", ""), "impact")
-    impact = _parse_impact(impact_data)
-    vehicles = _parse_vehicles(_require(data, "vehicles", ""), model)
+    impact = _parse_impact(impact_data, kind)
+    vehicles = _parse_vehicles(_require(data, "vehicles", ""), model, kind)
     extra = {key: data[key] for key in data if key not in _SCENE_KEYS}
     warnings = _ignored(extra, "", _SCENE_METADATA)
     warnings += _ignored(impact_data, "impact", _IMPACT_KEYS)
@@ -233,12 +241,21 @@ def _parse_scene(data: Any, source: Path | None) -> Scene:
     return Scene(model, units, impact, vehicles, source, extra, tuple(warnings))
 
 
-def _parse_impact(data: Mapping) -> Impact:
-    """Validate the ``impact`` table."""
+def _parse_impact(data: Mapping, kind: str) -> Impact:
+    """Validate the ``impact`` table. A reconstruction infers the coefficients,
+    so it needs only ``normal_angle``; an inverse needs a numeric impulse ratio."""
+    normal_angle = _number(_require(data, "normal_angle", "impact"), "impact.normal_angle")
+    if kind == "reconstruct":
+        return Impact(normal_angle=normal_angle, restitution=math.nan, impulse_ratio=math.nan,
+                      moment_restitution=math.nan)
+    ratio = _impulse_ratio(_require(data, "impulse_ratio", "impact"))
+    if kind == "inverse" and ratio == CRITICAL:
+        raise SceneError('must be a number for an inverse solution: with "critical" the final '
+                         "velocities do not determine the tangential slip", "impact.impulse_ratio")
     return Impact(
-        normal_angle=_number(_require(data, "normal_angle", "impact"), "impact.normal_angle"),
+        normal_angle=normal_angle,
         restitution=_number(_require(data, "restitution", "impact"), "impact.restitution"),
-        impulse_ratio=_impulse_ratio(_require(data, "impulse_ratio", "impact")),
+        impulse_ratio=ratio,
         moment_restitution=_number(data.get("moment_restitution", 1.0), "impact.moment_restitution"),
     )
 
@@ -253,34 +270,40 @@ def _impulse_ratio(value: Any) -> Union[float, str]:
         raise SceneError(f'must be a finite number or "critical", got {_show(value)}', "impact.impulse_ratio") from None
 
 
-def _parse_vehicles(raw: Any, model: str) -> tuple[Vehicle, Vehicle]:
+def _parse_vehicles(raw: Any, model: str, kind: str) -> tuple[Vehicle, Vehicle]:
     """Validate the list of exactly two vehicles; at most one may be fixed."""
     if not isinstance(raw, list):
         raise SceneError(f"must be a list of exactly 2 vehicles, got {_show(raw)}", "vehicles")
     if len(raw) != 2:
         raise SceneError(f"must be a list of exactly 2 vehicles, got {len(raw)}", "vehicles")
-    first, second = (_parse_vehicle(entry, index, model) for index, entry in enumerate(raw))
+    first, second = (_parse_vehicle(entry, index, model, kind) for index, entry in enumerate(raw))
     if first.fixed and second.fixed:
         raise SceneError("both vehicles are fixed; at most one may be", "vehicles")
     return first, second
 
 
-def _parse_vehicle(raw: Any, index: int, model: str) -> Vehicle:
-    """Validate one vehicle entry of the given model.
+def _parse_vehicle(raw: Any, index: int, model: str, kind: str) -> Vehicle:
+    """Validate one vehicle entry of the given model and scene kind.
 
-    A moving vehicle needs ``mass`` and ``velocity``, and in the rigid model
-    also ``yaw_inertia`` and ``impact_point``.  A fixed vehicle needs none of
-    them.  Keys given but not needed are still checked.
+    A moving vehicle needs ``mass`` and ``velocity`` (an inverse or
+    reconstruction scene: ``final_velocity`` instead, and a reconstruction also
+    ``heading``), and in the rigid model also ``yaw_inertia`` and
+    ``impact_point``.  A fixed vehicle needs none of them.  Keys given but not
+    needed are still checked.
     """
     path = f"vehicles[{index}]"
     data = _mapping(raw, path)
     fixed = _flag(data.get("fixed", False), f"{path}.fixed")
     rigid = model == "rigid"
+    for key in _KIND_KEYS[kind]:
+        if not fixed:
+            _require(data, key, path)
     return Vehicle(
         name=_name(data.get("name", f"vehicle {index + 1}"), f"{path}.name"),
         mass=_optional(data, "mass", path, _positive, required=not fixed),
         yaw_inertia=_optional(data, "yaw_inertia", path, _positive, required=rigid and not fixed),
-        velocity=_optional(data, "velocity", path, _vector, required=not fixed, default=(0.0, 0.0)),
+        velocity=_optional(data, "velocity", path, _vector, required=not fixed and kind == "forward",
+                           default=(0.0, 0.0)),
         yaw_rate=_optional(data, "yaw_rate", path, _number, default=0.0),
         impact_point=_optional(
             data, "impact_point", path, _vector, required=rigid and not fixed, default=(0.0, 0.0)
@@ -288,6 +311,13 @@ def _parse_vehicle(raw: Any, index: int, model: str) -> Vehicle:
         fixed=fixed,
         extra=_vehicle_extra(data, path),
     )
+
+
+_KIND_KEYS = {
+    "forward": (),
+    "inverse": ("final_velocity",),
+    "reconstruct": ("final_velocity", "heading"),
+}
 
 
 def _vehicle_extra(data: Mapping, path: str) -> dict[str, Any]:

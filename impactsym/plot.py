@@ -1,0 +1,628 @@
+"""Scene diagrams with matplotlib: geometry, velocities, delta-V, PDOF, yaw.
+
+:func:`scene` draws one scene, or one solved scene, in the scene frame with
+equal axes:
+
+- each vehicle as an outline (a rectangle from the optional ``length``,
+  ``width`` and ``heading`` of its scene entry; a dot where they are absent)
+  with its centre of gravity; a fixed body as a hatched barrier along the crush
+  surface;
+- the impact centre, the crush surface (the line through the impact centre
+  along ``t``) and the normal ``n`` (from vehicle 1 toward vehicle 2);
+- the pre-impact velocities and, for a result, the post-impact ones, the
+  delta-V (drawn from the tip of the pre-impact arrow to the tip of the
+  post-impact one) and the principal direction of force (PDOF, the direction
+  of the impulse on the vehicle: ``P`` on vehicle 1, ``-P`` on vehicle 2);
+- yaw rates as curved arrows around the centre of gravity (counter-clockwise
+  positive), before dashed, after solid;
+- a legend with units.
+
+Placement: a scene file gives only ``r_i``, the vector from each centre of
+gravity to the impact centre. The impact centre is put at the origin (or at
+``impact.position`` when the scene data carry one) and each centre of gravity
+at ``impact centre - r_i``. Particles have no impact point: they are drawn a
+small distance either side of the impact centre along ``n``.
+
+All numbers come from the scene and from the result (``solve()``); this module
+only draws them. matplotlib is imported inside the functions, so
+``import impactsym`` neither needs nor loads it (``pip install 'impactsym[plot]'``).
+
+Results are duck-typed, so other kinds of result (inverse, reconstruction)
+can be drawn as long as they provide:
+
+- ``vehicles``: two entries with ``velocity`` and ``delta_v`` (and
+  ``yaw_rate`` for the rigid model). For a :class:`~impactsym.result.Result`
+  ``velocity``/``yaw_rate`` are the *final* motion and the initial motion is
+  read from the scene. A result whose ``kind`` attribute is ``"invert"`` or
+  ``"reconstruct"`` has the *initial* motion in ``velocity``/``yaw_rate``;
+  its final motion is the scene's ``final_velocity``/``final_yaw_rate``, or
+  ``velocity + delta_v``. Explicit ``initial_velocity``, ``final_velocity``,
+  ``initial_yaw_rate`` and ``final_yaw_rate`` attributes take precedence.
+- optionally ``Pn`` and ``Pt`` (impulse on vehicle 1 in the impact frame) for
+  the PDOF (otherwise the direction of delta-V is used), and ``mu``, ``mu_c``,
+  ``TL``, ``flags``, ``units`` for the title.
+
+The scene itself comes from ``scene=`` or from a ``scene`` attribute of the
+result.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Optional, Union
+
+from .codes import FLAG_ENERGY_CREATED, FLAG_MU_BEYOND_CRITICAL, FLAG_TENSILE_IMPULSE
+from .result import UNIT_LABELS
+from .scene import Scene, SceneError, _read_file, load_scene
+
+__all__ = ["scene", "save_plot", "add_plot_argument", "INSTALL_HINT", "PRE_IMPACT_KINDS"]
+
+INSTALL_HINT = "diagrams need matplotlib: pip install 'impactsym[plot]' (or pip install matplotlib)"
+
+#: Result kinds whose ``velocity``/``yaw_rate`` are the pre-impact motion.
+PRE_IMPACT_KINDS = ("invert", "inverse", "reconstruct", "reconstruction")
+
+LENGTH_UNITS = {"SI": "m", "US": "ft"}
+
+_ARROW_LENGTH = 1.8  # the longest velocity arrow, in characteristic lengths
+_PARTICLE_OFFSET = 0.35  # particle distance from the impact centre, in characteristic lengths
+_COLOR = {
+    "before": "tab:blue",
+    "after": "tab:green",
+    "delta_v": "tab:orange",
+    "pdof": "tab:purple",
+    "normal": "black",
+    "surface": "tab:brown",
+}
+_FILL = ("#c6dbef", "#fdd0a2")
+_EDGE = ("#08519c", "#a63603")
+_FLAG_SHORT = {
+    FLAG_ENERGY_CREATED: "energy created",
+    FLAG_TENSILE_IMPULSE: "tensile normal impulse",
+    FLAG_MU_BEYOND_CRITICAL: "μ not between 0 and μ_c",
+}
+
+SceneLike = Union[Scene, Mapping, str, Path]
+
+
+@dataclass
+class _Body:
+    """What is drawn for one vehicle (scene frame, scene units)."""
+
+    name: str
+    fixed: bool
+    cg: tuple[float, float]
+    outline: Optional[tuple[float, float, float]] = None  # length, width, heading [deg]
+    v0: Optional[tuple[float, float]] = None  # pre-impact velocity
+    v1: Optional[tuple[float, float]] = None  # post-impact velocity
+    dv: Optional[tuple[float, float]] = None  # delta-V
+    w0: Optional[float] = None  # pre-impact yaw rate
+    w1: Optional[float] = None  # post-impact yaw rate
+    force: Optional[tuple[float, float]] = None  # direction of the impulse on the body (unit)
+
+
+# --------------------------------------------------------------------------- public
+
+
+def scene(scene_or_result: Any, ax=None, *, scene: Optional[SceneLike] = None, result: Any = None,
+          velocity_scale: Optional[float] = None, legend: bool = True, title: Optional[str] = None):
+    """Draw a scene, or a solved scene, on ``ax`` (a new figure when ``None``).
+
+    ``scene_or_result`` is a scene (a :class:`~impactsym.scene.Scene`, a
+    mapping in scene-file form or a file path) or a result (a
+    :class:`~impactsym.result.Result` or a duck-typed look-alike, see the
+    module docstring). A scene may be given its ``result=``; a result needs its
+    ``scene=`` unless it has a ``scene`` attribute.
+
+    ``velocity_scale`` is the drawn length (scene length unit) of one velocity
+    unit; by default the longest arrow is about twice the vehicles' size.
+    Returns the axes.
+    """
+    the_scene, the_result, position = _resolve(scene_or_result, scene, result)
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        _, ax = plt.subplots(figsize=(9.0, 6.5), layout="constrained")
+    _draw(ax, the_scene, the_result, position, velocity_scale, legend, title)
+    return ax
+
+
+def save_plot(scene_or_result: Any, path: Union[str, Path], *, scene: Optional[SceneLike] = None,
+              result: Any = None, dpi: int = 120, **options) -> Path:
+    """Draw like :func:`scene` and write the figure to ``path``.
+
+    The format follows the suffix (``.png``, ``.svg``, ``.pdf``, ...). Uses a
+    plain Agg canvas (no pyplot, no display needed). Returns the path.
+    Raises :class:`ImportError` (with the install command) without matplotlib
+    and :class:`OSError` when the file cannot be written.
+    """
+    the_scene, the_result, position = _resolve(scene_or_result, scene, result)
+    _require_matplotlib()
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(9.0, 6.5), layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    _draw(ax, the_scene, the_result, position, options.pop("velocity_scale", None),
+          options.pop("legend", True), options.pop("title", None))
+    if options:
+        raise TypeError(f"save_plot: unexpected options {', '.join(sorted(options))}")
+    path = Path(path)
+    fig.savefig(path, dpi=dpi)
+    return path
+
+
+def add_plot_argument(parser: argparse.ArgumentParser) -> None:
+    """Add ``--plot PATH`` to a command's parser (``impactsym solve SCENE --plot out.png``).
+
+    The value is checked when parsed: matplotlib must be installed and the
+    suffix must be an image format matplotlib writes; otherwise argparse
+    reports a usage error (one line, exit code 2 in the CLI).
+    """
+    parser.add_argument(
+        "--plot", metavar="PATH", type=_plot_path, default=None,
+        help="also draw the scene diagram to PATH (.png, .svg, .pdf; needs matplotlib)",
+    )
+
+
+# --------------------------------------------------------------------------- inputs
+
+
+def _require_matplotlib() -> None:
+    if importlib.util.find_spec("matplotlib") is None:
+        raise ImportError(INSTALL_HINT)
+
+
+_FORMATS = (".png", ".svg", ".pdf", ".jpg", ".jpeg", ".eps", ".ps", ".webp", ".tif", ".tiff")
+
+
+def _plot_path(text: str) -> Path:
+    """``--plot`` argument type: a path with an image suffix, matplotlib installed."""
+    path = Path(text)
+    if path.suffix.lower() not in _FORMATS:
+        raise argparse.ArgumentTypeError(
+            f"--plot {text}: unknown image type {path.suffix or '(none)'!r} (use .png, .svg or .pdf)")
+    if importlib.util.find_spec("matplotlib") is None:
+        raise argparse.ArgumentTypeError(f"--plot: {INSTALL_HINT}")
+    return path
+
+
+def _is_scene_like(obj: Any) -> bool:
+    return isinstance(obj, (Scene, Mapping, str, Path))
+
+
+def _resolve(obj: Any, scene: Optional[SceneLike], result: Any) -> tuple[Scene, Any, tuple[float, float]]:
+    """The scene, the result (or ``None``) and the impact-centre position."""
+    if _is_scene_like(obj):
+        if scene is not None:
+            raise TypeError("plot: give the scene once (positionally or as scene=)")
+        scene = obj
+    else:
+        if result is not None:
+            raise TypeError("plot: give the result once (positionally or as result=)")
+        result = obj
+        if scene is None:
+            scene = getattr(result, "scene", None)
+        if scene is None:
+            raise TypeError(
+                f"plot: a {type(result).__name__} does not carry its scene; pass scene=... "
+                "(the scene file or Scene it was solved from)")
+    if result is not None and not hasattr(result, "vehicles"):
+        raise TypeError(f"plot: expected a result with vehicles, got {type(result).__name__}")
+    return load_scene(scene), result, _impact_position(scene)
+
+
+def _impact_position(source: SceneLike) -> tuple[float, float]:
+    """``impact.position`` of the scene data when present, else the origin."""
+    impact = None
+    if isinstance(source, Scene):
+        impact = source.impact
+        position = getattr(impact, "position", None)
+        if position is None:
+            position = getattr(impact, "extra", {}).get("position") if hasattr(impact, "extra") else None
+        if position is None:
+            position = source.extra.get("impact_position")
+        if position is None and source.source is not None:
+            try:
+                raw = _read_file(source.source)
+            except (OSError, SceneError):
+                raw = None
+            position = _raw_position(raw)
+    elif isinstance(source, Mapping):
+        position = _raw_position(source)
+    else:
+        try:
+            position = _raw_position(_read_file(Path(source)))
+        except (OSError, SceneError):
+            position = None
+    if position is None:
+        return (0.0, 0.0)
+    try:
+        x, y = (float(value) for value in position)
+    except (TypeError, ValueError):
+        raise SceneError(f"must be a list of 2 finite numbers, got {position!r}", "impact.position") from None
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise SceneError(f"must be a list of 2 finite numbers, got {position!r}", "impact.position")
+    return (x, y)
+
+
+def _raw_position(raw: Any):
+    if isinstance(raw, Mapping):
+        impact = raw.get("impact")
+        if isinstance(impact, Mapping) and "position" in impact:
+            return impact["position"]
+        return raw.get("impact_position")
+    return None
+
+
+def _vec(value: Any) -> Optional[tuple[float, float]]:
+    if value is None:
+        return None
+    try:
+        x, y = (float(item) for item in value)
+    except (TypeError, ValueError):
+        return None
+    return (x, y) if math.isfinite(x) and math.isfinite(y) else None
+
+
+def _num(value: Any) -> Optional[float]:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return None
+    return number if math.isfinite(number) else None
+
+
+def _first(*values):
+    for value in values:
+        if value is not None:
+            return value
+    return None
+
+
+def _add(a, b):
+    return (a[0] + b[0], a[1] + b[1])
+
+
+def _sub(a, b):
+    return (a[0] - b[0], a[1] - b[1])
+
+
+def _scale(a, k):
+    return (a[0] * k, a[1] * k)
+
+
+def _norm(a) -> float:
+    return math.hypot(a[0], a[1])
+
+
+# --------------------------------------------------------------------------- layout
+
+
+def _frame(scene: Scene):
+    gamma = math.radians(scene.impact.normal_angle)
+    n = (math.cos(gamma), math.sin(gamma))
+    t = (-math.sin(gamma), math.cos(gamma))
+    return n, t
+
+
+def _outline(vehicle, velocity) -> Optional[tuple[float, float, float]]:
+    """(length, width, heading) when the scene entry gives length and width."""
+    length, width = _num(vehicle.extra.get("length")), _num(vehicle.extra.get("width"))
+    if length is None or width is None:
+        return None
+    heading = _num(vehicle.extra.get("heading"))
+    if heading is None:
+        heading = math.degrees(math.atan2(velocity[1], velocity[0])) if velocity and _norm(velocity) > 0 else 0.0
+    return (length, width, heading)
+
+
+def _characteristic_length(scene: Scene) -> float:
+    sizes = []
+    for vehicle in scene.vehicles:
+        if vehicle.fixed:
+            continue
+        if scene.model == "rigid":
+            sizes.append(_norm(vehicle.impact_point))
+        for key in ("length", "width"):
+            size = _num(vehicle.extra.get(key))
+            if size is not None:
+                sizes.append(0.5 * size)
+    size = max(sizes, default=0.0)
+    return size if size > 0 else 1.0
+
+
+def _bodies(scene: Scene, result: Any, centre, size: float) -> list[_Body]:
+    """Placement and motion of both bodies."""
+    n, t = _frame(scene)
+    kind = str(getattr(result, "kind", "solve") or "solve").lower() if result is not None else None
+    rigid = scene.model == "rigid"
+    bodies = []
+    for index, vehicle in enumerate(scene.vehicles):
+        entry = result.vehicles[index] if result is not None else None
+        v0, v1, dv, w0, w1 = _motion(vehicle, entry, kind, rigid)
+        outline = _outline(vehicle, _first(v0, v1))
+        if rigid:
+            cg = _sub(centre, vehicle.impact_point)
+        else:
+            offset = 0.5 * outline[0] if outline else _PARTICLE_OFFSET * size
+            cg = _add(centre, _scale(n, offset if index else -offset))
+        bodies.append(_Body(vehicle.name, vehicle.fixed, cg, outline, v0, v1, dv, w0, w1))
+    _set_forces(bodies, result, n, t)
+    return bodies
+
+
+def _motion(vehicle, entry, kind, rigid):
+    """(v0, v1, dv, w0, w1) of one vehicle; ``None`` where unknown or not drawn."""
+    if vehicle.fixed:
+        return None, None, None, None, None
+    scene_v0 = _vec(vehicle.velocity)
+    scene_w0 = _num(vehicle.yaw_rate)
+    scene_v1 = _vec(vehicle.extra.get("final_velocity"))
+    scene_w1 = _num(vehicle.extra.get("final_yaw_rate"))
+    if entry is None:
+        v0, v1, dv, w0, w1 = scene_v0, scene_v1, None, scene_w0, scene_w1
+    else:
+        velocity, rate = _vec(getattr(entry, "velocity", None)), _num(getattr(entry, "yaw_rate", None))
+        if kind in PRE_IMPACT_KINDS:
+            v0, w0 = _first(velocity, scene_v0), _first(rate, scene_w0)
+            v1, w1 = scene_v1, scene_w1
+        else:
+            v0, w0 = scene_v0, scene_w0
+            v1, w1 = velocity, rate
+        v0 = _first(_vec(getattr(entry, "initial_velocity", None)), v0)
+        v1 = _first(_vec(getattr(entry, "final_velocity", None)), v1)
+        w0 = _first(_num(getattr(entry, "initial_yaw_rate", None)), w0)
+        w1 = _first(_num(getattr(entry, "final_yaw_rate", None)), w1)
+        dv = _vec(getattr(entry, "delta_v", None))
+        if dv is not None and v1 is None and v0 is not None:
+            v1 = _add(v0, dv)
+        if dv is not None and v0 is None and v1 is not None:
+            v0 = _sub(v1, dv)
+        if dv is None and v0 is not None and v1 is not None:
+            dv = _sub(v1, v0)
+    if not rigid:
+        w0 = w1 = None
+    return v0, v1, dv, w0, w1
+
+
+def _set_forces(bodies: list[_Body], result: Any, n, t) -> None:
+    """PDOF: P = Pn·n + Pt·t on vehicle 1, -P on vehicle 2; else the delta-V direction."""
+    if result is None:
+        return
+    pn, pt = _num(getattr(result, "Pn", None)), _num(getattr(result, "Pt", None))
+    impulse = _add(_scale(n, pn), _scale(t, pt)) if pn is not None and pt is not None else None
+    for index, body in enumerate(bodies):
+        direction = None
+        if impulse is not None:
+            direction = impulse if index == 0 else _scale(impulse, -1.0)
+        elif body.dv is not None:
+            direction = body.dv
+        if direction is not None and _norm(direction) > 0:
+            body.force = _scale(direction, 1.0 / _norm(direction))
+
+
+# --------------------------------------------------------------------------- drawing
+
+
+class _Canvas:
+    """Draws on an axes and remembers every point, for the limits."""
+
+    def __init__(self, ax):
+        from matplotlib.patches import FancyArrowPatch, Polygon
+        from matplotlib.path import Path as MplPath
+
+        self.ax = ax
+        self.points: list[tuple[float, float]] = []
+        self._arrow, self._polygon, self._path = FancyArrowPatch, Polygon, MplPath
+
+    def arrow(self, tail, head, color, lw=2.0, ls="-", alpha=1.0, zorder=4, scale=14):
+        if _norm(_sub(head, tail)) <= 0:
+            return
+        self.ax.add_patch(self._arrow(tail, head, arrowstyle="-|>", mutation_scale=scale, color=color, lw=lw,
+                                      linestyle=ls, alpha=alpha, shrinkA=0, shrinkB=0, zorder=zorder))
+        self.points += [tail, head]
+
+    def arc(self, centre, radius, start_deg, sweep_deg, color, ls, zorder=5):
+        steps = max(8, int(abs(sweep_deg) / 6))
+        points = []
+        for step in range(steps + 1):
+            angle = math.radians(start_deg + sweep_deg * step / steps)
+            points.append((centre[0] + radius * math.cos(angle), centre[1] + radius * math.sin(angle)))
+        self.ax.add_patch(self._arrow(path=self._path(points), arrowstyle="-|>", mutation_scale=11,
+                                      color=color, lw=1.6, linestyle=ls, zorder=zorder))
+        self.points += points
+        return points[-1]
+
+    def polygon(self, corners, **style):
+        self.ax.add_patch(self._polygon(corners, closed=True, **style))
+        self.points += list(corners)
+
+    def line(self, a, b, **style):
+        self.ax.plot([a[0], b[0]], [a[1], b[1]], **style)
+        self.points += [a, b]
+
+    def marker(self, point, **style):
+        self.ax.plot([point[0]], [point[1]], **style)
+        self.points.append(point)
+
+    def text(self, point, label, **style):
+        self.ax.text(point[0], point[1], label, **style)
+        self.points.append(point)
+
+    def limits(self, pad: float):
+        xs = [p[0] for p in self.points]
+        ys = [p[1] for p in self.points]
+        return (min(xs) - pad, max(xs) + pad), (min(ys) - pad, max(ys) + pad)
+
+
+def _rotated(centre, heading_deg, local):
+    c, s = math.cos(math.radians(heading_deg)), math.sin(math.radians(heading_deg))
+    return [(centre[0] + c * x - s * y, centre[1] + s * x + c * y) for x, y in local]
+
+
+def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, title: Optional[str]) -> None:
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    units = scene.units
+    speed_unit = UNIT_LABELS[units]["velocity"]
+    length_unit = LENGTH_UNITS[units]
+    size = _characteristic_length(scene)
+    bodies = _bodies(scene, result, centre, size)
+    n, t = _frame(scene)
+    canvas = _Canvas(ax)
+    handles = []
+
+    # velocity scale: drawn length per velocity unit
+    vectors = [v for body in bodies for v in (body.v0, body.v1, body.dv) if v is not None]
+    vmax = max((_norm(v) for v in vectors), default=0.0)
+    k = velocity_scale if velocity_scale else (_ARROW_LENGTH * size / vmax if vmax > 0 else 1.0)
+    rates = [abs(w) for body in bodies for w in (body.w0, body.w1) if w is not None]
+    wmax = max(rates, default=0.0)
+
+    # vehicles and the barrier
+    reach = size
+    for index, body in enumerate(bodies):
+        if body.fixed:
+            side = 1.0 if index == 1 else -1.0
+            half = max(1.2 * size, 0.5 * body.outline[0] if body.outline else 0.0)
+            depth = body.outline[1] if body.outline else 0.3 * size
+            corners = [_add(centre, _scale(t, -half)), _add(centre, _scale(t, half)),
+                       _add(_add(centre, _scale(t, half)), _scale(n, side * depth)),
+                       _add(_add(centre, _scale(t, -half)), _scale(n, side * depth))]
+            canvas.polygon(corners, facecolor="0.9", edgecolor="0.2", hatch="///", lw=1.2, zorder=1)
+            canvas.text(_add(_add(centre, _scale(t, 0.75 * half)), _scale(n, side * (depth + 0.12 * size))),
+                        body.name, ha="center", va="center", fontsize=9, color="0.2", zorder=6)
+            handles.append(Patch(facecolor="0.9", edgecolor="0.2", hatch="///", label="fixed barrier"))
+            continue
+        fill, edge = _FILL[index], _EDGE[index]
+        if body.outline:
+            length, width, heading = body.outline
+            half_l, half_w = 0.5 * length, 0.5 * width
+            canvas.polygon(_rotated(body.cg, heading, [(half_l, half_w), (-half_l, half_w),
+                                                       (-half_l, -half_w), (half_l, -half_w)]),
+                           facecolor=fill, edgecolor=edge, lw=1.5, alpha=0.9, zorder=1)
+            canvas.polygon(_rotated(body.cg, heading, [(0.92 * half_l, 0.0), (0.62 * half_l, 0.45 * half_w),
+                                                       (0.62 * half_l, -0.45 * half_w)]),
+                           facecolor=edge, edgecolor=edge, alpha=0.6, zorder=1)
+            reach = max(reach, half_l)
+            handles.append(Patch(facecolor=fill, edgecolor=edge, label=f"{body.name} (outline, front ▶)"))
+        else:
+            canvas.marker(body.cg, ls="none", marker="o", ms=16, mfc=fill, mec=edge, mew=1.5, zorder=2)
+            handles.append(Line2D([], [], ls="none", marker="o", ms=10, mfc=fill, mec=edge, label=body.name))
+        canvas.marker(body.cg, ls="none", marker="o", ms=7, mfc="white", mec="black", mew=1.2, zorder=7)
+        canvas.marker(body.cg, ls="none", marker="+", ms=7, mec="black", mew=1.2, zorder=8)
+        label_at = _add(body.cg, _scale(n, (1 if index else -1) * 0.28 * size))
+        canvas.text(label_at, body.name, ha="center", va="center", fontsize=9, color=edge, zorder=6,
+                    bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.7))
+
+    # crush surface, normal, impact centre
+    half = 1.2 * reach
+    canvas.line(_add(centre, _scale(t, -half)), _add(centre, _scale(t, half)),
+                color=_COLOR["surface"], lw=2.5, zorder=3)
+    tip = _add(centre, _scale(n, 0.6 * size))
+    canvas.arrow(centre, tip, _COLOR["normal"], lw=1.5, zorder=6)
+    canvas.text(_add(tip, _scale(n, 0.1 * size)), "n", ha="center", va="center", fontsize=11,
+                fontweight="bold", zorder=6)
+    canvas.marker(centre, ls="none", marker="X", ms=10, mfc="black", mec="white", zorder=9)
+
+    # motion
+    drawn = set()
+    for index, body in enumerate(bodies):
+        if body.v0 is not None:
+            canvas.arrow(body.cg, _add(body.cg, _scale(body.v0, k)), _COLOR["before"], lw=2.2, alpha=0.85)
+            drawn.add("before")
+        if body.v1 is not None:
+            canvas.arrow(body.cg, _add(body.cg, _scale(body.v1, k)), _COLOR["after"], lw=2.2)
+            drawn.add("after")
+        if body.dv is not None and _norm(body.dv) > 0:
+            tail = _add(body.cg, _scale(body.v0, k)) if body.v0 is not None else body.cg
+            head = _add(tail, _scale(body.dv, k))
+            canvas.arrow(tail, head, _COLOR["delta_v"], lw=2.0, ls="--", zorder=5)
+            middle = _scale(_add(tail, head), 0.5)
+            canvas.text(middle, f"|ΔV| {_norm(body.dv):.3g}", fontsize=8, color=_COLOR["delta_v"],
+                        ha="left", va="bottom", zorder=6)
+            drawn.add("delta_v")
+        if body.force is not None:
+            tail = _sub(body.cg, _scale(body.force, 0.75 * size))
+            canvas.arrow(tail, body.cg, _COLOR["pdof"], lw=1.8, ls="-.", zorder=6, scale=12)
+            angle = math.degrees(math.atan2(body.force[1], body.force[0])) % 360.0
+            canvas.text(_sub(tail, _scale(body.force, 0.08 * size)), f"PDOF {angle:.0f}°", fontsize=8,
+                        color=_COLOR["pdof"], ha="center", va="center", zorder=6)
+            drawn.add("pdof")
+        for rate, radius, ls, key in ((body.w0, 0.32, "--", "yaw_before"), (body.w1, 0.46, "-", "yaw_after")):
+            if rate is None or wmax <= 0 or abs(rate) <= 1e-9 * wmax:
+                continue
+            sweep = math.copysign(40.0 + 230.0 * abs(rate) / wmax, rate)
+            start = 100.0 if index == 0 else -80.0
+            color = _COLOR["before"] if key == "yaw_before" else _COLOR["after"]
+            end = canvas.arc(body.cg, radius * size, start, sweep, color, ls)
+            canvas.text(end, f" {rate:+.3g}", fontsize=8, color=color, ha="left", va="center", zorder=6)
+            drawn.add(key)
+
+    handles += [
+        Line2D([], [], ls="none", marker="o", ms=7, mfc="white", mec="black", label="centre of gravity"),
+        Line2D([], [], ls="none", marker="X", ms=9, mfc="black", mec="white", label="impact centre"),
+        Line2D([], [], color=_COLOR["surface"], lw=2.5, label="crush surface (along t)"),
+        Line2D([], [], color=_COLOR["normal"], lw=1.5, marker=">", ms=5,
+               label=f"normal n (Γ = {scene.impact.normal_angle:g}°)"),
+    ]
+    legend_lines = {
+        "before": (dict(color=_COLOR["before"], lw=2.2), f"velocity before [{speed_unit}]"),
+        "after": (dict(color=_COLOR["after"], lw=2.2), f"velocity after [{speed_unit}]"),
+        "delta_v": (dict(color=_COLOR["delta_v"], lw=2.0, ls="--"), f"delta-V [{speed_unit}]"),
+        "pdof": (dict(color=_COLOR["pdof"], lw=1.8, ls="-."), "PDOF (impulse on vehicle) [°]"),
+        "yaw_before": (dict(color=_COLOR["before"], lw=1.6, ls="--"), "yaw rate before [rad/s] (ccw +)"),
+        "yaw_after": (dict(color=_COLOR["after"], lw=1.6), "yaw rate after [rad/s] (ccw +)"),
+    }
+    handles += [Line2D([], [], label=label, **style) for key, (style, label) in legend_lines.items()
+                if key in drawn]
+
+    xlim, ylim = canvas.limits(0.15 * size)
+    ax.set_xlim(*xlim)
+    ax.set_ylim(*ylim)
+    ax.set_aspect("equal", adjustable="box")
+    ax.grid(True, lw=0.4, alpha=0.5)
+    schematic = " (positions schematic)" if scene.model == "particle" else ""
+    ax.set_xlabel(f"x [{length_unit}]{schematic}")
+    ax.set_ylabel(f"y [{length_unit}]")
+    ax.set_title(title if title is not None else _title(scene, result), fontsize=10)
+    if result is not None:
+        flags = int(_num(getattr(result, "flags", 0)) or 0)
+        problems = [text for bit, text in _FLAG_SHORT.items() if flags & bit]
+        if problems:
+            ax.text(0.01, 0.01, "flagged: " + "; ".join(problems), transform=ax.transAxes, fontsize=9,
+                    color="crimson", ha="left", va="bottom", zorder=10,
+                    bbox=dict(boxstyle="round,pad=0.25", fc="white", ec="crimson", alpha=0.85))
+    if legend:
+        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8,
+                  title=f"arrows: 1 {length_unit} = {1.0 / k:.3g} {speed_unit}", title_fontsize=8,
+                  frameon=False)
+
+
+def _title(scene: Scene, result: Any) -> str:
+    impact = scene.impact
+    name = scene.source.name if scene.source is not None else "scene"
+    mu = "μ = μ_c" if impact.critical else f"μ = {float(impact.impulse_ratio):g}"
+    em = f", e_m = {impact.moment_restitution:g}" if scene.model == "rigid" else ""
+    head = f"{name}: {scene.model} model, {scene.units}; e = {impact.restitution:g}, {mu}{em}"
+    if result is None:
+        return head
+    energy = UNIT_LABELS[scene.units]["energy"]
+    parts = []
+    mu_value, mu_c = _num(getattr(result, "mu", None)), _num(getattr(result, "mu_c", None))
+    if mu_value is not None:
+        parts.append(f"μ = {mu_value:.3g}")
+    if mu_c is not None:
+        parts.append(f"μ_c = {mu_c:.3g}")
+    loss = _num(getattr(result, "TL", None))
+    if loss is not None:
+        parts.append(f"energy loss TL = {loss:.4g} {energy}")
+    return head + ("\n" + ", ".join(parts) if parts else "")
