@@ -474,6 +474,8 @@ def markdown(methods, timing, errors, sets, args) -> str:
     lines += [f"- **{fam}**: {text}." for fam, text in S.FAMILIES]
     lines += ["", "## Findings (generated from the numbers above)", ""]
     lines += _findings(methods, timing, errors)
+    lines += ["", "Stress families where the default kernel is not the most accurate:", ""]
+    lines += _family_findings(methods, errors, stress)
     lines += ["", "## Machine", "",
               f"{platform.machine()}, {os.cpu_count()} CPUs, numba {numba.__version__} with "
               f"{numba.get_num_threads()} threads, NumPy {np.__version__}, Python "
@@ -483,7 +485,9 @@ def markdown(methods, timing, errors, sets, args) -> str:
               + ", ".join(f"{m.label} {timing[m.key].get('first_call_s', math.nan):.2f} s"
                           for m in methods)
               + ". The numba kernels use every thread (prange); `numpy.linalg.solve` and the "
-              "lambdified NumPy code run on one."]
+              "lambdified NumPy code run on one. Load average (1 min) when timing started: "
+              f"{timing['_load']:.2f}" + (" — other processes competed for the CPUs, so the "
+                                          "times are noisy." if timing["_load"] > 0.5 else ".")]
     return "\n".join(lines) + "\n"
 
 
@@ -506,64 +510,92 @@ def _findings(methods, timing, errors) -> list[str]:
         if math.isfinite(ew) and math.isfinite(bw) and bw > 0:
             parts.append(f"TL self-relative (stress) {ew / bw:.3g}× the default's")
         out.append("- " + "; ".join(parts) + ".")
-    better = [(m.label, s) for m in methods[1:] for s in SET_NAMES
+    better = [f"{m.label} on the {s} set ({errors[m.key][s].worst() / errors['default'][s].worst():.2g}×)"
+              for m in methods[1:] for s in SET_NAMES
               if errors[m.key][s].worst() < errors["default"][s].worst()]
-    if better:
-        out.append("- More accurate than the default on the worst row: "
-                   + ", ".join(f"{label} ({s})" for label, s in better) + ".")
-    else:
-        out.append("- No method beats the default kernel's worst error on either set.")
+    out.append("- Worst row more accurate than the default's: " + (", ".join(better) or "none") + ".")
     return out
 
 
-def chart(methods, timing, errors, path: Path) -> None:
+def _family_findings(methods, errors, stress) -> list[str]:
+    """Stress families where some method's worst error is < 1/2 of the default's."""
+    from . import sets as S
+
+    out = []
+    for fam, _ in S.FAMILIES:
+        mask = stress.family == fam
+        base = float(np.max(errors["default"]["stress"].row[mask]))
+        best = min(methods[1:], key=lambda m: float(np.max(errors[m.key]["stress"].row[mask])))
+        mine = float(np.max(errors[best.key]["stress"].row[mask]))
+        if mine < base / 2:
+            i = np.flatnonzero(mask)[int(np.argmax(errors["default"]["stress"].row[mask]))]
+            out.append(f"- **{fam}**: the default's worst is {_fmt(base)} (row {i}, output "
+                       f"`{errors['default']['stress'].which[i]}`); {best.label} reaches "
+                       f"{_fmt(mine)}, {base / max(mine, 1e-300):.2g}× better.")
+    return out or ["- On every stress family the default is within 2× of the best method."]
+
+
+def chart(methods, timing, errors, path: Path, n: int) -> None:
     """Log-log chart, one panel per set: x = ns/scene, y = error (worst filled,
     p99 hollow), one colour per method."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import (FixedLocator, FormatStrFormatter, NullFormatter,
+                                   NullLocator)
 
     colors = plt.get_cmap("tab10").colors
-    fig, axes = plt.subplots(1, 2, figsize=(13, 5.6), sharey=True, constrained_layout=True)
-    order = sorted(range(len(methods)), key=lambda i: timing[methods[i].key]["ns"])
+    fig, axes = plt.subplots(1, 2, figsize=(13, 5.8), sharey=True, constrained_layout=True)
+    xs = [timing[m.key]["ns"] for m in methods]
+    # label offsets cycle through four corners, in order of run time
+    rank = {i: r for r, i in enumerate(sorted(range(len(methods)), key=lambda i: xs[i]))}
+    corners = [((7, 7), "left"), ((7, -13), "left"), ((-7, 7), "right"), ((-7, -13), "right")]
     for ax, s in zip(axes, SET_NAMES):
-        for rank, i in enumerate(order):
-            m, color = methods[i], colors[i % len(colors)]
-            x = timing[m.key]["ns"]
+        for i, m in enumerate(methods):
+            color = colors[i % len(colors)]
             err = errors[m.key][s]
             w, p = err.worst(), err.p99()
             yw = FAIL_Y if not math.isfinite(w) else max(w, EXACT_Y)
             yp = FAIL_Y if not math.isfinite(p) else max(p, EXACT_Y)
-            ax.plot([x, x], [yp, yw], color=color, lw=1, alpha=0.6)
-            ax.scatter([x], [yw], s=70, color=color, zorder=3,
+            ax.plot([xs[i], xs[i]], [yp, yw], color=color, lw=1, alpha=0.6)
+            ax.scatter([xs[i]], [yw], s=70, color=color, zorder=3,
                        marker="X" if not math.isfinite(w) else "o",
                        label=m.label if s == SET_NAMES[0] else None)
-            ax.scatter([x], [yp], s=70, facecolors="none", edgecolors=color, zorder=3,
+            ax.scatter([xs[i]], [yp], s=70, facecolors="none", edgecolors=color, zorder=3,
                        marker="X" if not math.isfinite(p) else "o", linewidths=1.5)
-            text = m.label + (f": fail ({err.fails})" if err.fails else "")
-            ax.annotate(text, (x, yw), textcoords="offset points", fontsize=8, color=color,
-                        xytext=(7, 8 if rank % 2 == 0 else -12))
-        ax.axhline(UNIT_ROUNDOFF, color="grey", ls=":", lw=1)
-        ax.text(1.02, UNIT_ROUNDOFF * 1.6, "2^-53", fontsize=7,
-                color="grey", transform=ax.get_yaxis_transform())
-        ax.axhline(TEST_TOL, color="grey", ls="--", lw=1)
-        ax.text(1.02, TEST_TOL * 1.6, "1e-12 (tests)", fontsize=7, color="grey",
-                transform=ax.get_yaxis_transform())
+            text = m.label + (f": fail ({err.fails} rows)" if err.fails else "")
+            offset, ha = corners[rank[i] % len(corners)]
+            ax.annotate(text, (xs[i], yw), textcoords="offset points", fontsize=8, color=color,
+                        xytext=offset, ha=ha)
+        for y, text, style in ((UNIT_ROUNDOFF, "2^-53", ":"), (TEST_TOL, "1e-12 (tests)", "--")):
+            ax.axhline(y, color="grey", ls=style, lw=1)
+            ax.text(0.01, y * 1.8, text, fontsize=7, color="grey",
+                    transform=ax.get_yaxis_transform())
         ax.axhline(FAIL_Y, color="red", ls="-", lw=0.5, alpha=0.4)
+        ax.text(0.01, FAIL_Y * 1.8, "fail", fontsize=7, color="red",
+                transform=ax.get_yaxis_transform())
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_ylim(EXACT_Y / 3, FAIL_Y * 10)
-        xs = [timing[m.key]["ns"] for m in methods]
-        ax.set_xlim(min(xs) / 1.6, max(xs) * 4)
-        ax.set_xlabel("run time, ns per scene (n = 1e6, median)")
+        ax.set_xlim(min(xs) / 1.8, max(xs) * 3)
+        ticks = [t for t in (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 10000,
+                             20000, 50000) if min(xs) / 1.8 <= t <= max(xs) * 3]
+        ax.xaxis.set_major_locator(FixedLocator(ticks))
+        ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_xlabel(f"run time, ns per scene (n = {n:,}, median)")
         ax.set_title(f"{s} set: worst (filled) and p99 (hollow) error")
         ax.grid(True, which="major", alpha=0.3)
-    axes[0].set_ylabel("error / natural scale  (fail: top line, 0: bottom)")
+    axes[0].set_ylabel("error / natural scale (0 drawn at the bottom)")
     sec = axes[1].secondary_yaxis("right", functions=(
-        lambda y: np.log2(np.maximum(y, 1e-300)) + 53, lambda b: np.exp2(b - 53)))
-    sec.set_ylabel("bits lost vs float64 (log2(err / 2^-53))")
-    axes[0].legend(loc="upper left", fontsize=8, ncol=2)
+        lambda y: np.log2(np.maximum(y, 1e-300)) + 53,
+        lambda b: np.exp2(np.clip(b - 53, -1000, 1000))))
+    sec.yaxis.set_major_locator(FixedLocator([0, 10, 20, 30, 40, 50, 60]))
+    sec.yaxis.set_major_formatter(FormatStrFormatter("%d"))
+    sec.yaxis.set_minor_locator(NullLocator())
+    sec.set_ylabel("bits lost: log2(error / 2^-53)")
+    axes[0].legend(loc="upper left", fontsize=8, ncol=2, bbox_to_anchor=(0.0, 0.93))
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
@@ -603,14 +635,16 @@ def main(args) -> int:
             errors[m.key][s] = set_errors(outs, scene_sets[s])
         log(f"  errors {m.label}: realistic {_fmt(errors[m.key]['realistic'].worst())}, "
             f"stress {_fmt(errors[m.key]['stress'].worst(), errors[m.key]['stress'].fails)}")
-    log(f"timing n = {args.n} ...")
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else math.nan
+    log(f"timing n = {args.n} (load average {load:.2f}) ...")
     timing = time_methods(methods, tile(scene_sets["realistic"].columns, args.n), args.repeat, log)
+    timing["_load"] = load
     for key, seconds in first_call.items():
         timing[key]["first_call_s"] = seconds
     args.out.mkdir(parents=True, exist_ok=True)
     text = markdown(methods, timing, errors, scene_sets, args)
     (args.out / "accuracy.md").write_text(text)
-    chart(methods, timing, errors, args.out / "accuracy.png")
+    chart(methods, timing, errors, args.out / "accuracy.png", args.n)
     print(text)
     log(f"wrote {args.out / 'accuracy.md'} and {args.out / 'accuracy.png'} "
         f"in {time.perf_counter() - t_start:.0f} s")

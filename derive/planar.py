@@ -130,6 +130,31 @@ def effective_determinant():
     return kk**2 + kk * arms + r12**2 * (wa * wb + wa * wc + wb * wc)
 
 
+def compliance_pieces():
+    """Assignments of the pieces K needs, from (drx, dry) and r_n, r_t already
+    assigned: kk, jbar, the weights, the moment coupling am (for inverse and
+    reconstruction kernels, which assemble their own frames)."""
+    drn_, drt_ = f.to_impact_frame(drx, dry)
+    C = compliance()
+    return (
+        Block(((drn, drn_), (drt, drt_), (kk, k1 + k2), (jbar, j1 * j2 / (j1 + j2)))),
+        Block(((am, (1 - e_m) / C[2, 2]), (wa, e_m * j1), (wb, e_m * j2),
+               (wc, (1 - e_m) * jbar), (Cnm, C[0, 2]), (Ctm, C[1, 2]))),
+    )
+
+
+def critical_ratio_blocks():
+    """μ_c of a scene whose initial relative motion (gn, gt, wr) and e, e_m are
+    known: the effective compliance, then the sticking ratio (Pt/Pn with zero
+    final slip), with its denominator guarded."""
+    return (
+        Block(tuple(effective_compliance().items())),
+        Block(((bn, (1 + e) * gn - hn), (bt, gt - ht))),
+        Block(((Dc, Ktt * bn - Knt * bt),), Guard((sp.Ne(Dc, 0),), "SINGULAR")),
+        Block(((mu_c, (Knn * bt - Knt * bn) / Dc),)),
+    )
+
+
 def _impulse_blocks(sticking: bool):
     """Restitution plus impulse ratio (sliding) or zero final slip (sticking)."""
     keff = effective_compliance()

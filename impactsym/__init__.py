@@ -15,6 +15,7 @@ from .batch import solve_batch
 from .codes import FLAG_MESSAGES, STATUS_MESSAGES, describe_flags, describe_status
 from .energy import delta_v_from_energy
 from .inverse import invert, invert_batch
+from .reconstruct import reconstruct, reconstruct_batch
 from .result import Result
 from .scene import Impact, Scene, SceneError, Vehicle, load_scene
 from .single import solve
@@ -23,5 +24,6 @@ __version__ = "0.1.0"
 
 __all__ = [
     "FLAG_MESSAGES", "STATUS_MESSAGES", "Impact", "Result", "Scene", "SceneError", "Vehicle",
-    "delta_v_from_energy", "describe_flags", "describe_status", "invert", "invert_batch", "load_scene", "solve", "solve_batch",
+    "delta_v_from_energy", "describe_flags", "describe_status", "invert", "invert_batch",
+    "reconstruct", "reconstruct_batch", "load_scene", "solve", "solve_batch",
 ]

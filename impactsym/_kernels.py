@@ -22,7 +22,7 @@ if getattr(generated, "IMPACTSYM_GENERATED", None) != "impactsym":
 
 import numpy as np  # noqa: E402
 
-from generated import delta_v, inverse, particle, planar  # noqa: E402
+from generated import delta_v, inverse, particle, planar, reconstruct  # noqa: E402
 
 SERIAL_BELOW = 64
 
@@ -65,6 +65,8 @@ INVERSE = {
     "rigid": _kernel_set(inverse, "rigid_inverse"),
     "particle": _kernel_set(inverse, "particle_inverse"),
 }
+RECONSTRUCT = _kernel_set(reconstruct, "reconstruct")
+
 INVERSE_OUTPUTS = ("v1x", "v1y", "w1", "v2x", "v2y", "w2", "Pn", "Pt", "M",
                    "mu_c", "TL", "TLn", "TLt", "TLm")
 

@@ -17,6 +17,7 @@ from typing import Callable
 
 from .scene import SceneError
 from .inverse import invert
+from .reconstruct import reconstruct
 from .single import solve
 
 __all__ = ["main", "build_parser", "Command", "COMMANDS"]
@@ -65,6 +66,11 @@ def _run_solve(args: argparse.Namespace) -> int:
     return _print_result(solve(args.scene), args.json)
 
 
+def _run_reconstruct(args: argparse.Namespace) -> int:
+    """Reconstruct pre-impact speeds from final motion and headings; print JSON or a table."""
+    return _print_result(reconstruct(args.scene), args.json)
+
+
 def _run_invert(args: argparse.Namespace) -> int:
     """Recover the pre-impact motion of an inverse scene; print JSON or a table."""
     return _print_result(invert(args.scene), args.json)
@@ -80,6 +86,11 @@ COMMANDS: dict[str, Command] = {
         "recover the pre-impact motion from the post-impact motion and e, mu, e_m",
         _add_solve,
         _run_invert,
+    ),
+    "reconstruct": Command(
+        "reconstruct pre-impact speeds from post-impact motion and pre-impact headings",
+        _add_solve,
+        _run_reconstruct,
     ),
 }
 

@@ -21,6 +21,9 @@ status meaning
        not determine the normal approach speed
 8      inverse: moment restitution |e_m| is zero or below 2^-20, so the final
        yaw rates do not determine the initial relative yaw rate
+9      reconstruction: the headings are collinear (|sin(θ1 - θ2)| < 2^-20), so
+       linear momentum does not determine the speeds
+10     reconstruction: a vehicle is fixed (its momentum is undefined)
 ====== ======================================================================
 
 ====== ======================================================================
@@ -30,6 +33,10 @@ flag   meaning (bits add up)
 2      tensile normal impulse: Pn >= 0 (a compressive impulse on vehicle 1
        points along -n)
 4      impulse ratio beyond critical: mu not between 0 and mu_c
+8      (reconstruction) the implied restitution e is outside [0, 1]
+16     (reconstruction) a speed is negative: the vehicle moved against its heading
+32     (reconstruction) the headings are within about 6° of collinear
+       (|sin(θ1 - θ2)| < 0.1): the speeds are sensitive to the headings
 ====== ======================================================================
 """
 
@@ -41,6 +48,9 @@ STATUS_OK = _codes.STATUS_OK
 FLAG_ENERGY_CREATED = _codes.FLAG_ENERGY_CREATED
 FLAG_TENSILE_IMPULSE = _codes.FLAG_TENSILE_IMPULSE
 FLAG_MU_BEYOND_CRITICAL = _codes.FLAG_MU_BEYOND_CRITICAL
+FLAG_E_OUT_OF_RANGE = _codes.FLAG_E_OUT_OF_RANGE
+FLAG_NEGATIVE_SPEED = _codes.FLAG_NEGATIVE_SPEED
+FLAG_HEADINGS_ILL_CONDITIONED = _codes.FLAG_HEADINGS_ILL_CONDITIONED
 
 STATUS_MESSAGES = {
     _codes.STATUS_OK: "solved",
@@ -59,6 +69,11 @@ STATUS_MESSAGES = {
     "velocities do not determine the normal approach speed (e appears in the denominator); "
     "give the pre-impact headings (impactsym reconstruct) or the energy loss "
     "(impactsym.delta_v_from_energy) instead",
+    _codes.STATUS_HEADINGS_COLLINEAR: "the pre-impact headings are collinear (or within "
+    "2^-20 rad): linear momentum does not determine the speeds; use the inverse solution "
+    "with restitution and impulse ratio (impactsym invert) instead",
+    _codes.STATUS_RECONSTRUCT_FIXED: "a reconstruction needs two moving vehicles (a fixed "
+    "body's momentum is undefined)",
     _codes.STATUS_INVERSE_EM_TOO_SMALL: "moment restitution e_m is zero or below 2^-20 in "
     "magnitude: the final yaw rates do not determine the initial relative yaw rate; give the "
     "pre-impact yaw rates (impactsym reconstruct) or use e_m = 1 (no moment impulse)",
@@ -70,6 +85,12 @@ FLAG_MESSAGES = {
     FLAG_TENSILE_IMPULSE: "tensile normal impulse: the vehicles would pull on each other",
     FLAG_MU_BEYOND_CRITICAL: "impulse ratio mu is not between 0 and the critical ratio mu_c: "
     "the friction impulse would reverse the sliding (seed Table 2)",
+    FLAG_E_OUT_OF_RANGE: "the implied restitution e is outside [0, 1]: the post-impact "
+    "motion, headings or impact centre are inconsistent",
+    FLAG_NEGATIVE_SPEED: "a reconstructed speed is negative: the vehicle would have moved "
+    "against its stated heading",
+    FLAG_HEADINGS_ILL_CONDITIONED: "the headings are within about 6 degrees of collinear: "
+    "the reconstructed speeds are very sensitive to the headings",
 }
 
 

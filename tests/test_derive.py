@@ -11,7 +11,7 @@ import pytest
 import sympy as sp
 
 from derive import __main__ as derive_main
-from derive import delta_v, emit, frame, inverse, particle, planar
+from derive import delta_v, emit, frame, inverse, particle, planar, reconstruct
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -21,7 +21,7 @@ def _run_derive(*args, cwd=ROOT):
                           capture_output=True, text=True, timeout=300)
 
 
-@pytest.mark.parametrize("module", [particle, planar, delta_v, inverse], ids=lambda m: m.__name__)
+@pytest.mark.parametrize("module", [particle, planar, delta_v, inverse, reconstruct], ids=lambda m: m.__name__)
 def test_every_proof_passes(module):
     failed = [claim for claim, ok in module.proofs() if not ok]
     assert not failed, f"failed proofs: {failed}"

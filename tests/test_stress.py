@@ -58,7 +58,6 @@ RATIO_FLAG_MARGIN = 1e-10
 flagged; inside by more than it must not be. Pn beyond +-this fraction of |P| likewise."""
 ENERGY_CREATED, TENSILE, MU_OUT_OF_RANGE = 1, 2, 4
 OUTPUT_KEYS = R.OUTPUTS
-VELOCITY_LIKE = ("V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M")
 ENERGY_LIKE = ("TL", "TLn", "TLt", "TLm")
 RATIO_LIKE = ("mu", "mu_c")
 EM_MAIN = (1.0, 0.5, 0.0)
@@ -551,18 +550,36 @@ def test_wild_mu_flags(base):
 
 # =============================================================================== Kane-Levinson
 
+def kane_levinson_columns(n=300, seed=4242):
+    """Random realistic rigid scenes as generated (mu a fraction of mu_c, half the rows with
+    e_m = 1, half with e_m in [-1, 0]), plus the e_m < 0 rows again with e_m in {0.5, 0}
+    and mu = U(0, 1) mu_c of the changed scene. Returns (columns, rows with e_m >= 0)."""
+    cols = scenes.random_realistic(n, seed)
+    neg = np.flatnonzero(cols["e_m"] < 0)
+    extra = _take(cols, neg)
+    extra["e_m"] = np.resize(np.array([0.5, 0.0]), neg.size)
+    rng = np.random.default_rng(seed)
+    extra = _set_mu_fraction(extra, "rigid", rng.random(neg.size))
+    cols = _concat(cols, extra)
+    return cols, np.flatnonzero(cols["e_m"] >= 0)
+
+
 def test_energy_created_with_mu_inside_range_is_flagged():
-    """Random realistic eccentric scenes with 0 <= mu < mu_c: about one in twenty creates
-    energy (Kane and Levinson); the flags catch every such row (and no clearly physical one)."""
-    cols = scenes.random_realistic(300, 4242)
-    _, refs, out = _check(cols, "rigid", False, "Kane-Levinson rigid 300", flags=True)
+    """Random realistic eccentric scenes with 0 <= mu < mu_c and 0 <= e_m <= 1: some create
+    energy (Kane and Levinson's paradox; about 1 in 13 of the e_m = 1 rows here); the
+    flags catch every such row, and every e_m < 0 row that creates energy too."""
+    cols, physical_em = kane_levinson_columns()
+    _, refs, out = _check(cols, "rigid", False, "Kane-Levinson rigid", flags=True)
     created = []
     for i, ref in enumerate(refs):
-        scales = R.natural_scales(R.row_of(cols, i), ref, "rigid")
-        must_set, _ = _expected_flags(R.row_of(cols, i), ref, scales, "rigid", False)
-        if must_set & ENERGY_CREATED and not must_set & MU_OUT_OF_RANGE:
+        row = R.row_of(cols, i)
+        must_set, _ = _expected_flags(row, ref, R.natural_scales(row, ref, "rigid"),
+                                      "rigid", False)
+        if must_set & ENERGY_CREATED:
             created.append(i)
-    assert len(created) >= 3, f"only {len(created)} Kane-Levinson rows in 300: family too weak"
+    paradox = [i for i in created if i in set(physical_em.tolist())]
+    assert len(paradox) >= 5, (f"only {len(paradox)} energy-creating rows with "
+                               f"0 <= mu <= mu_c, 0 <= e_m <= 1: family too weak")
     missed = [i for i in created if not out["flags"][i] & ENERGY_CREATED]
     assert not missed, f"energy-creating rows not flagged: {missed}"
 
