@@ -14,7 +14,10 @@ from impactsym.codes import FLAG_MESSAGES
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
-EXAMPLE_FILES = sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml"))
+# Forward scenes; the other kinds are named by their command (invert_*, reconstruct_*, ...).
+OTHER_KINDS = ("invert_", "reconstruct_", "crash3_")
+EXAMPLE_FILES = [path for path in sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml"))
+                 if not path.name.startswith(OTHER_KINDS)]
 ENERGY_CREATED = 1
 
 CONVENTIONS_SCENE = json.loads((EXAMPLES / "two_car_us.json").read_text())
