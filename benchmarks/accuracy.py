@@ -47,7 +47,7 @@ import platform
 import sys
 import tempfile
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
@@ -375,6 +375,34 @@ def tile(columns: dict, n: int) -> dict:
             for k, v in columns.items()}
 
 
+def _cpu_busy_seconds() -> float:
+    """CPU seconds the whole machine has spent busy (Linux /proc/stat), or NaN."""
+    try:
+        with open("/proc/stat") as f:
+            fields = [float(x) for x in f.readline().split()[1:]]
+    except OSError:
+        return math.nan
+    idle = fields[3] + (fields[4] if len(fields) > 4 else 0.0)  # idle + iowait
+    return (sum(fields[:8]) - idle) / os.sysconf("SC_CLK_TCK")
+
+
+class OtherLoad:
+    """Share of the machine's CPUs that *other* processes used while the block ran
+    (busy CPU time of the machine minus this process's, over wall time x CPUs)."""
+
+    def __enter__(self):
+        self.t0, self.busy0, self.own0 = time.perf_counter(), _cpu_busy_seconds(), os.times()
+        return self
+
+    def __exit__(self, *exc):
+        wall = time.perf_counter() - self.t0
+        own1 = os.times()
+        own = (own1.user - self.own0.user) + (own1.system - self.own0.system)
+        other = _cpu_busy_seconds() - self.busy0 - own
+        self.share = max(0.0, other / (wall * (os.cpu_count() or 1))) if wall > 0 else math.nan
+        return False
+
+
 def time_methods(methods, columns: dict, repeat: int, log=print) -> dict[str, dict]:
     """Median ns per row of each method on ``columns``; timed round-robin."""
     n = len(next(iter(columns.values())))
@@ -386,15 +414,21 @@ def time_methods(methods, columns: dict, repeat: int, log=print) -> dict[str, di
         warm[m.key] = time.perf_counter() - t0
         log(f"  warm-up {m.label}: {warm[m.key]:.2f} s")
     samples = {m.key: [] for m in methods}
+    others = []
     for r in range(repeat):
         for m in methods:
-            t0 = time.perf_counter_ns()
-            runs[m.key]()
-            samples[m.key].append((time.perf_counter_ns() - t0) / n)
-        log(f"  repeat {r + 1}/{repeat}: " + ", ".join(
+            with OtherLoad() as load:
+                t0 = time.perf_counter_ns()
+                runs[m.key]()
+                samples[m.key].append((time.perf_counter_ns() - t0) / n)
+            others.append(load.share)
+        log(f"  repeat {r + 1}/{repeat} (other processes {np.nanmax(others[-len(methods):]):.0%} "
+            "of the CPUs at most): " + ", ".join(
             f"{m.label} {samples[m.key][-1]:.1f}" for m in methods) + " ns/scene")
-    return {k: {"ns": float(np.median(v)), "samples": v, "warmup_s": warm[k]}
-            for k, v in samples.items()}
+    out = {k: {"ns": float(np.median(v)), "samples": v, "warmup_s": warm[k]}
+           for k, v in samples.items()}
+    out["_other_cpu"] = float(np.nanmean(others)) if others else math.nan
+    return out
 
 
 # ------------------------------------------------------------------ report
@@ -437,7 +471,8 @@ def markdown(methods, timing, errors, sets, args) -> str:
         f"{sets['stress'].n} constructed rows (families below).",
         "",
         "| method | ns/scene | × default | realistic worst | realistic p99 | stress worst "
-        "| stress p99 | bits (stress) | TL self-rel. worst, realistic | TL self-rel. worst, stress |",
+        "| stress p99 | bits (stress) | TL self-rel. worst, realistic "
+        "| TL self-rel. worst, stress |",
         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for m in methods:
@@ -476,19 +511,37 @@ def markdown(methods, timing, errors, sets, args) -> str:
     lines += _findings(methods, timing, errors)
     lines += ["", "Stress families where the default kernel is not the most accurate:", ""]
     lines += _family_findings(methods, errors, stress)
+    lines += ["", "## Code measured", "", _code_state()]
     lines += ["", "## Machine", "",
               f"{platform.machine()}, {os.cpu_count()} CPUs, numba {numba.__version__} with "
               f"{numba.get_num_threads()} threads, NumPy {np.__version__}, Python "
-              f"{platform.python_version()}. First call ({sets['realistic'].n} rows, includes the JIT "
-              "compile; the variants compile from scratch every run, the default loads numba's "
-              "cache): "
+              f"{platform.python_version()}. First call ({sets['realistic'].n} rows, includes "
+              "the JIT compile; the variants compile from scratch every run, the default "
+              "loads numba's cache): "
               + ", ".join(f"{m.label} {timing[m.key].get('first_call_s', math.nan):.2f} s"
                           for m in methods)
               + ". The numba kernels use every thread (prange); `numpy.linalg.solve` and the "
-              "lambdified NumPy code run on one. Load average (1 min) when timing started: "
-              f"{timing['_load']:.2f}" + (" — other processes competed for the CPUs, so the "
-                                          "times are noisy." if timing["_load"] > 0.5 else ".")]
+              "lambdified NumPy code run on one. Other processes used "
+              f"{timing['_other_cpu']:.0%} of the CPUs during the timed runs (mean)"
+              + (": the times are noisy." if timing["_other_cpu"] > 0.1 else ".")]
     return "\n".join(lines) + "\n"
+
+
+def _code_state() -> str:
+    """Which derive source the default kernels and the rendered variants come from."""
+    import re
+
+    from derive import emit
+
+    gen = Path(__file__).resolve().parent.parent / "generated" / "planar.py"
+    found = re.search(r"derive source sha256 ([0-9a-f]{64})", gen.read_text())
+    generated = found.group(1) if found else "?"
+    current = emit.source_hash()
+    text = (f"generated/planar.py header: derive source sha256 `{generated[:16]}…`; the variants "
+            f"were rendered from derive/ at `{current[:16]}…`")
+    if generated != current:
+        return text + " — **generated/ is stale**: run `python -m derive`, then this benchmark."
+    return text + " (the same source)."
 
 
 def _findings(methods, timing, errors) -> list[str]:
@@ -510,10 +563,12 @@ def _findings(methods, timing, errors) -> list[str]:
         if math.isfinite(ew) and math.isfinite(bw) and bw > 0:
             parts.append(f"TL self-relative (stress) {ew / bw:.3g}× the default's")
         out.append("- " + "; ".join(parts) + ".")
-    better = [f"{m.label} on the {s} set ({errors[m.key][s].worst() / errors['default'][s].worst():.2g}×)"
+    better = [f"{m.label} on the {s} set "
+              f"({errors[m.key][s].worst() / errors['default'][s].worst():.2g}×)"
               for m in methods[1:] for s in SET_NAMES
               if errors[m.key][s].worst() < errors["default"][s].worst()]
-    out.append("- Worst row more accurate than the default's: " + (", ".join(better) or "none") + ".")
+    out.append("- Worst row more accurate than the default's: "
+               + (", ".join(better) or "none") + ".")
     return out
 
 
@@ -579,8 +634,8 @@ def chart(methods, timing, errors, path: Path, n: int) -> None:
         ax.set_yscale("log")
         ax.set_ylim(EXACT_Y / 3, FAIL_Y * 10)
         ax.set_xlim(min(xs) / 1.8, max(xs) * 3)
-        ticks = [t for t in (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 10000,
-                             20000, 50000) if min(xs) / 1.8 <= t <= max(xs) * 3]
+        ticks = [t for t in (1, 2, 3, 5, 10, 20, 30, 50, 100, 200, 300, 500, 1000, 2000, 3000,
+                             5000, 10000, 20000, 50000) if min(xs) / 1.8 <= t <= max(xs) * 3]
         ax.xaxis.set_major_locator(FixedLocator(ticks))
         ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
         ax.xaxis.set_minor_formatter(NullFormatter())
@@ -635,10 +690,8 @@ def main(args) -> int:
             errors[m.key][s] = set_errors(outs, scene_sets[s])
         log(f"  errors {m.label}: realistic {_fmt(errors[m.key]['realistic'].worst())}, "
             f"stress {_fmt(errors[m.key]['stress'].worst(), errors[m.key]['stress'].fails)}")
-    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else math.nan
-    log(f"timing n = {args.n} (load average {load:.2f}) ...")
+    log(f"timing n = {args.n} ...")
     timing = time_methods(methods, tile(scene_sets["realistic"].columns, args.n), args.repeat, log)
-    timing["_load"] = load
     for key, seconds in first_call.items():
         timing[key]["first_call_s"] = seconds
     args.out.mkdir(parents=True, exist_ok=True)

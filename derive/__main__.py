@@ -13,7 +13,7 @@ import os
 import sys
 from pathlib import Path
 
-MODEL_MODULES = ("particle", "planar", "delta_v", "inverse", "reconstruct")
+MODEL_MODULES = ("particle", "planar", "delta_v", "inverse", "reconstruct", "presets", "crash3")
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -36,7 +36,8 @@ def render_all() -> dict[str, str]:
     for name in MODEL_MODULES:
         mod = importlib.import_module(f"derive.{name}")
         doc = (mod.__doc__ or "").strip().splitlines()[0]
-        files[f"{name}.py"] = emit.render_module(f"{name}.py", doc, mod.KERNELS, digest)
+        files[f"{name}.py"] = emit.render_module(f"{name}.py", doc, mod.KERNELS, digest,
+                                                 data=getattr(mod, "DATA", ()))
     files["codes.py"] = emit.render_codes(digest)
     files["__init__.py"] = emit.render_init(MODEL_MODULES, digest)
     return files

@@ -11,6 +11,7 @@ naming, no timestamps). Arithmetic is strict IEEE: no fastmath.
 from __future__ import annotations
 
 import hashlib
+import pprint
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -43,6 +44,18 @@ class KernelPrinter(PythonCodePrinter):
 
     def _print_Half(self, expr):
         return "0.5"
+
+    def _print_Mul(self, expr):
+        """As CodePrinter, except that a lone squared denominator keeps its
+        parentheses: x/y**2 is printed x/(y*y), never x/y*y."""
+        text = super()._print_Mul(expr)
+        dens = [a for a in sp.Mul.make_args(expr)
+                if a.is_Pow and a.exp.is_Rational and a.exp.is_negative]
+        if len(dens) == 1 and dens[0].exp == -2:
+            square = self._print(sp.Pow(dens[0].base, 2, evaluate=False))
+            if text.endswith("/" + square):
+                text = text[: -len(square)] + f"({square})"
+        return text
 
     def _print_Pow(self, expr, rational=False):
         base, exp = expr.args
@@ -192,10 +205,14 @@ def batch_function(kernel: Kernel, parallel: bool, style: Style = DEFAULT) -> st
 
 
 def render_module(model_file: str, doc: str, kernels, digest: str,
-                  style: Style = DEFAULT) -> str:
-    """A whole generated module as text."""
+                  style: Style = DEFAULT, data=()) -> str:
+    """A whole generated module as text. `data` holds (NAME, value) pairs of
+    plain Python literals (numbers, strings, tuples, dicts) written as module
+    constants before the kernels: tables a model module derives, not formulas."""
     parts = [header(model_file, digest), f'"""{doc}"""', "",
              *style.imports, "", "from numba import njit, prange", ""]
+    for name, value in data:
+        parts += [f"{name} = {pprint.pformat(value, width=100, sort_dicts=False)}", ""]
     for knl in kernels:
         parts += [f"{knl.name.upper()}_INPUTS = {tuple(str(s) for s in knl.inputs)!r}",
                   f"{knl.name.upper()}_OUTPUTS = {knl.output_names()!r}", ""]

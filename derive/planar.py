@@ -34,7 +34,7 @@ r1n, r1t, r2n, r2t = real("r1n r1t r2n r2t")
 Cnn, Cnt, Ctt, Cnm, Ctm, Cmm = real("Cnn Cnt Ctt Cnm Ctm Cmm")
 Knn, Knt, Ktt, hn, ht, am = real("Knn Knt Ktt hn ht am")
 drx, dry, drn, drt, r12, kk, jbar, wa, wb, wc = real("drx dry drn drt r12 kk jbar wa wb wc")
-bn, bt, D, Dc, s, c1, c2 = real("bn bt D Dc s c1 c2")
+bn, bt, D, Dc, s, c1, c2, cd, qy = real("bn bt D Dc s c1 c2 cd qy")
 
 
 def _perp(rn, rt):
@@ -175,36 +175,65 @@ def _impulse_blocks(sticking: bool):
     )
 
 
+def lever_products_sticking():
+    """c1 = r1 × P, c2 = r2 × P and cd = (r1 - r2) × P of the sticking impulse
+    P = K⁻¹ b, by Cramer's rule: c = (bt·(K ρ)_n - bn·(K ρ)_t) / det K for
+    ρ = (r_n, r_t) of r1, r2 and r1 - r2.
+
+    With a small yaw inertia (large j_i) sticking makes P nearly parallel to
+    r_i (or to r1 - r2 when both are small), so the cross product from (Pn, Pt)
+    would be a small difference of large products, then multiplied by the
+    large j. In K ρ the large terms drop out exactly (s_i · ρ_i = 0 and
+    (s1 - s2)·(ρ1 - ρ2) = 0); the dot products left are ±(r1 × r2) = ±r12."""
+    k_rho1 = (kk * r1n + r12 * (wb * r2t - wc * drt), kk * r1t + r12 * (wc * drn - wb * r2n))
+    k_rho2 = (kk * r2n - r12 * (wa * r1t + wc * drt), kk * r2t + r12 * (wa * r1n + wc * drn))
+    k_rhod = (kk * drn + r12 * (wa * r1t + wb * r2t), kk * drt - r12 * (wa * r1n + wb * r2n))
+    return tuple((bt * kn - bn * kt) / D for kn, kt in (k_rho1, k_rho2, k_rhod))
+
+
+def yaw_changes():
+    """W1 - w1 = j1 (c1 + M) and W2 - w2 = -j2 (c2 + M) with M = am·s written
+    out: with qy = j1 c1 + j2 c2,
+        W1 - w1 =  (e_m qy + (1 - e_m) wr)·j1/(j1 + j2) + jbar·cd,
+        W2 - w2 = -(e_m qy + (1 - e_m) wr)·j2/(j1 + j2) + jbar·cd.
+    No c + M cancellation (M ≈ -c1 at e_m = 0), and the part that survives
+    large inertial weights, jbar·cd, uses cd = (r1 - r2) × P directly."""
+    jsum = compliance()[2, 2]
+    common = e_m * qy + (1 - e_m) * wr
+    return common * j1 / jsum + jbar * cd, -common * j2 / jsum + jbar * cd
+
+
 def _final_blocks(sticking: bool):
     """Finals from the impulses, and energy loss as the work of each component."""
     px, py = f.to_scene_frame(Pn, Pt)
     gt_final = 0 if sticking else gt - (Knt * Pn + Ktt * Pt) - ht
+    levers = lever_products_sticking() if sticking else (
+        _cross(r1n, r1t, Pn, Pt), _cross(r2n, r2t, Pn, Pt), _cross(drn, drt, Pn, Pt))
+    dw1, dw2 = yaw_changes()
     return (
         Block(
             (
-                (Px, px), (Py, py),
-                (c1, _cross(r1n, r1t, Pn, Pt)), (c2, _cross(r2n, r2t, Pn, Pt)),
-                # Relative yaw rate at separation if there were no moment impulse.
-                (s, wr - (Cnm * Pn + Ctm * Pt)),
+                (Px, px), (Py, py), (c1, levers[0]), (c2, levers[1]), (cd, levers[2]),
                 (mu_used, mu_c if sticking else mu),
                 # (gn + Gn) with Gn = -e·gn factors to (1 - e)·gn (see particle).
                 (TLn, Pn * sp.factor(gn - e * gn) / 2),
                 (TLt, Pt * (gt + gt_final) / 2),
             )
         ),
+        Block(((qy, j1 * c1 + j2 * c2), (V1x, v1x + k1 * Px), (V1y, v1y + k1 * Py),
+               (V2x, v2x - k2 * Px), (V2y, v2y - k2 * Py))),
         Block(
             (
-                (M, am * s),
-                (V1x, v1x + k1 * Px), (V1y, v1y + k1 * Py),
-                (V2x, v2x - k2 * Px), (V2y, v2y - k2 * Py),
+                # Relative yaw rate at separation if there were no moment impulse.
+                (s, wr - qy),
+                (W1, w1 + dw1), (W2, w2 + dw2),
             )
         ),
         Block(
             (
-                (W1, w1 + j1 * (c1 + M)),
-                (W2, w2 - j2 * (c2 + M)),
+                (M, am * s),
                 # W2 - W1 = e_m·s at separation.
-                (TLm, M * (wr + e_m * s) / 2),
+                (TLm, am * s * (wr + e_m * s) / 2),
             )
         ),
         Block(((TL, TLn + TLt + TLm),)),
@@ -262,6 +291,19 @@ def ke_difference_kernel() -> Kernel:
 KEEP = frozenset({k1, k2, j1, j2, nx, ny})
 
 
+def _cross_products(knl: Kernel) -> dict:
+    """c_i → r_i × P in terms of (Pn, Pt): the lever products as the sliding
+    kernel computes them (for the sticking kernel: lemma `_cramer_levers`)."""
+    rn = {x: knl.expanded(x, KEEP) for x in (r1n, r1t, r2n, r2t, drn, drt)}
+    return {c1: _cross(rn[r1n], rn[r1t], Pn, Pt), c2: _cross(rn[r2n], rn[r2t], Pn, Pt),
+            cd: _cross(rn[drn], rn[drt], Pn, Pt)}
+
+
+def _expanded(knl: Kernel, sym, atoms=frozenset()):
+    """`sym` expanded down to KEEP ∪ atoms ∪ {c1, c2, cd}, then c = r × P."""
+    return knl.expanded(sym, KEEP | atoms | {c1, c2, cd}).xreplace(_cross_products(knl))
+
+
 def _zero(expr) -> bool:
     return f.reduce_unit_normal(expr) == 0
 
@@ -312,8 +354,7 @@ def _six_equations_hold(knl: Kernel, sticking: bool) -> bool:
     2. the kernel's (Pn, Pt), as functions of K, h, gn, gt, e, μ, satisfy
        restitution and the impulse ratio (or zero final slip);
     3. so the scene-frame restitution and ratio residuals vanish."""
-    at = KEEP | {Pn, Pt}
-    free = {sym: knl.expanded(sym, at) for sym in knl.outputs + (Px, Py)}
+    free = {sym: _expanded(knl, sym, {Pn, Pt}) for sym in knl.outputs + (Px, Py)}
     res, rel = six_equation_residuals(free, sticking)
     Gn, Gt = f.to_impact_frame(*rel)
     keff = {sym: knl.expanded(sym, KEEP) for sym in (Knn, Knt, Ktt, hn, ht, gn, gt)}
@@ -357,7 +398,6 @@ def _kernel_checks(knl: Kernel, sticking: bool, sliding: Kernel | None = None):
     an identity or a multiple of a residual already proven zero; that keeps
     every check exact and fast."""
     tag = knl.name
-    got = {sym: knl.expanded(sym, KEEP) for sym in knl.outputs + (Px, Py)}
     out = [(f"{tag}: the closed forms satisfy the six equations",
             _six_equations_hold(knl, sticking))]
     g0 = tuple(c.xreplace({dvx: v2x - v1x, dvy: v2y - v1y}) for c in relative_velocity())
@@ -365,9 +405,11 @@ def _kernel_checks(knl: Kernel, sticking: bool, sliding: Kernel | None = None):
     wr0 = w2 - w1
     # Lemma: for ANY impulse (Pn, Pt, M), the kinetic energy lost is the work of
     # the components on the mean relative velocity (conventions.md, Energy).
-    free = {sym: knl.expanded(sym, KEEP | {Pn, Pt, M}) for sym in (V1x, V1y, W1, V2x, V2y, W2)}
-    _, rel = six_equation_residuals({**free, Px: knl.expanded(Px, KEEP | {Pn, Pt}),
-                                      Py: knl.expanded(Py, KEEP | {Pn, Pt}), M: M}, sticking)
+    px, py = (knl.expanded(x, KEEP | {Pn, Pt}) for x in (Px, Py))
+    lever = _cross_products(knl)
+    free = {V1x: v1x + k1 * px, V1y: v1y + k1 * py, V2x: v2x - k2 * px, V2y: v2y - k2 * py,
+            W1: w1 + j1 * (lever[c1] + M), W2: w2 - j2 * (lever[c2] + M)}
+    _, rel = six_equation_residuals({**free, Px: px, Py: py, M: M}, sticking)
     Gn, Gt = f.to_impact_frame(*rel)
     ke = [(vx**2 + vy**2) / (2 * k) + w**2 / (2 * j)
           for vx, vy, w, k, j in ((v1x, v1y, w1, k1, j1), (v2x, v2y, w2, k2, j2))]
@@ -377,33 +419,54 @@ def _kernel_checks(knl: Kernel, sticking: bool, sliding: Kernel | None = None):
     out.append((f"{tag}: kinetic energy lost = work of Pn, Pt, M (any impulse)",
                 _zero(sum(ke) - sum(KE) - work)))
     # The kernel's parts, with (Pn, Pt) free and M the kernel's M(Pn, Pt).
-    at = KEEP | {Pn, Pt}
-    m_k = knl.expanded(M, at)
+    at = frozenset({Pn, Pt})
+    m_k = _expanded(knl, M, at)
     Gn_k, Gt_k, Wr_k = (x.xreplace({M: m_k}) for x in (Gn, Gt, free[W2] - free[W1]))
     restitution = Gn_k + e * gn0
     slip = Gt_k if sticking else 0
     out.append((f"{tag}: TLn, TLt, TLm are those works given restitution"
                 + (" and zero final slip" if sticking else ""),
-                _zero(knl.expanded(TLn, at) - Pn * (gn0 + Gn_k) / 2 + Pn * restitution / 2)
-                and _zero(knl.expanded(TLt, at) - Pt * (gt0 + Gt_k) / 2 + Pt * slip / 2)
-                and _zero(knl.expanded(TLm, at) - m_k * (wr0 + Wr_k) / 2)
-                and sp.expand(got[TL] - got[TLn] - got[TLt] - got[TLm]) == 0))
+                _zero(_expanded(knl, TLn, at) - Pn * (gn0 + Gn_k) / 2 + Pn * restitution / 2)
+                and _zero(_expanded(knl, TLt, at) - Pt * (gt0 + Gt_k) / 2 + Pt * slip / 2)
+                and _zero(_expanded(knl, TLm, at) - m_k * (wr0 + Wr_k) / 2)
+                and knl.expanded(TL, frozenset({TLn, TLt, TLm})) == TLn + TLt + TLm))
     if sticking:
+        out.append((f"{tag}: Cramer's c1, c2, cd equal r1, r2, r1 - r2 x P of the sticking impulse",
+                    _cramer_levers(knl)))
         out.append((f"{tag}: equals the sliding kernel at mu = mu_c",
                     _sticking_is_sliding_at_critical(knl, sliding)))
     else:
         out.append((f"{tag}: mu = mu_c makes the final tangential relative velocity vanish",
                     _critical_ratio_ends_slip(knl, Gt_k)))
+        got = {sym: knl.expanded(sym, KEEP) for sym in (V1x, V1y, V2x, V2y)}
         out.append((f"{tag}: zero lever arms reduce to the particle model, eqs 10-13",
                     _reduces_to_particle(got)))
     return out
 
 
+def _cramer_levers(stick: Kernel) -> bool:
+    """Lemma: the sticking kernel's c_i (Cramer's rule, r12 and Cauchy–Binet
+    det K) equal r_i × P of its (Pn, Pt), as identities in the impact-frame
+    lever arms, kk, the weights and (bn, bt)."""
+    atoms = frozenset({r1n, r1t, r2n, r2t, kk, wa, wb, wc, bn, bt, drn, drt, r12, D})
+    frame = {drn: r1n - r2n, drt: r1t - r2t, r12: r1n * r2t - r1t * r2n}
+    keff = {k: v.xreplace(frame) for k, v in effective_compliance().items()}
+    det = (keff[Knn] * keff[Ktt] - keff[Knt]**2)
+    sub = {**frame, D: det}
+
+    def at_atoms(sym):
+        return stick.expanded(sym, atoms).xreplace(keff).xreplace(sub)
+
+    pn, pt = at_atoms(Pn), at_atoms(Pt)
+    return all(sp.simplify(at_atoms(c) - _cross(rn, rt, pn, pt)) == 0
+               for c, rn, rt in ((c1, r1n, r1t), (c2, r2n, r2t), (cd, r1n - r2n, r1t - r2t)))
+
+
 def _sticking_is_sliding_at_critical(stick: Kernel, slide: Kernel) -> bool:
     """Same finals as functions of (Pn, Pt), and the same (Pn, Pt) at μ = μ_c
     (an identity in K, bn, bt)."""
-    at = KEEP | {Pn, Pt}
-    same_finals = all(sp.expand(stick.expanded(o, at) - slide.expanded(o, at)) == 0
+    at = frozenset({Pn, Pt})
+    same_finals = all(sp.expand(_expanded(stick, o, at) - _expanded(slide, o, at)) == 0
                       for o in (V1x, V1y, W1, V2x, V2y, W2, M))
     stick_atoms, lemma = _small_atoms(True)
     slide_atoms = _small_atoms(False)[0] | {bn, bt}

@@ -1,0 +1,44 @@
+"""How the inverse solution's error grows as e → 0 (the seed: "e appears in the
+denominator"). Forward-solve realistic scenes at a given e, invert the float64
+finals, and measure how far the recovered initials are from the true ones, in
+units of the scene's speed scale (largest initial or final speed).
+
+    python -m benchmarks inverse
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+import impactsym
+from tests import scenes
+
+RESTITUTIONS = (0.5, 0.1, 0.05, 0.01, 1e-3, 1e-4, 1e-5, 1e-6)
+INITIALS = ("v1x", "v1y", "w1", "v2x", "v2y", "w2")
+FINALS = ("V1x", "V1y", "W1", "V2x", "V2y", "W2")
+
+
+def round_trip_errors(e: float, n: int = 2000, seed: int = 3) -> np.ndarray:
+    """Per-row worst error of invert(forward(x)) against x, speed-scale units."""
+    c = scenes.random_realistic(n, seed=seed)
+    c["e"] = np.full(n, e)
+    c["e_m"] = np.ones(n)
+    fwd = impactsym.solve_batch(c)
+    finals = {k: v for k, v in c.items() if k not in INITIALS}
+    finals.update({k: fwd[k] for k in FINALS})
+    inv = impactsym.invert_batch(finals)
+    scale = np.max([np.hypot(c["v1x"], c["v1y"]), np.hypot(c["v2x"], c["v2y"]),
+                    np.hypot(fwd["V1x"], fwd["V1y"]), np.hypot(fwd["V2x"], fwd["V2y"])], axis=0)
+    ok = (fwd["status"] == 0) & (inv["status"] == 0)
+    errors = np.max([np.abs(inv[k] - c[k]) / scale for k in INITIALS if k[0] == "v"], axis=0)
+    return errors[ok]
+
+
+def main(argv=None) -> int:
+    """Print the error growth table (Markdown)."""
+    print("| e | median error | 99th percentile | worst |")
+    print("|---|---|---|---|")
+    for e in RESTITUTIONS:
+        err = round_trip_errors(e)
+        print(f"| {e:g} | {np.median(err):.1e} | {np.percentile(err, 99):.1e} | {err.max():.1e} |")
+    return 0
