@@ -12,6 +12,7 @@ import sys
 
 SUBCOMMANDS = {
     "accuracy": "benchmarks.accuracy",
+    "inverse": "benchmarks.inverse",
 }
 
 

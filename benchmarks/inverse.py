@@ -13,6 +13,7 @@ import numpy as np
 import impactsym
 from tests import scenes
 
+DESCRIPTION = "round-trip error of the inverse solution as e -> 0"
 RESTITUTIONS = (0.5, 0.1, 0.05, 0.01, 1e-3, 1e-4, 1e-5, 1e-6)
 INITIALS = ("v1x", "v1y", "w1", "v2x", "v2y", "w2")
 FINALS = ("V1x", "V1y", "W1", "V2x", "V2y", "W2")
@@ -34,7 +35,11 @@ def round_trip_errors(e: float, n: int = 2000, seed: int = 3) -> np.ndarray:
     return errors[ok]
 
 
-def main(argv=None) -> int:
+def add_arguments(parser) -> None:
+    """No options: the restitution values and the scene set are fixed."""
+
+
+def main(args=None) -> int:
     """Print the error growth table (Markdown)."""
     print("| e | median error | 99th percentile | worst |")
     print("|---|---|---|---|")

@@ -79,6 +79,12 @@ class Float32Printer(KernelPrinter):
     def _print_Half(self, expr):
         return "np.float32(0.5)"
 
+    def _print_Pow(self, expr, rational=False):
+        if expr.args[1] == -1:
+            base = self.parenthesize(expr.args[0], sp.printing.precedence.PRECEDENCE["Pow"])
+            return f"np.float32(1.0)/{base}"
+        return super()._print_Pow(expr, rational=rational)
+
 
 _SETTINGS = {"fully_qualified_modules": True, "standard": "python3"}
 
