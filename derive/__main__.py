@@ -13,7 +13,7 @@ import os
 import sys
 from pathlib import Path
 
-MODEL_MODULES = ("particle", "planar", "delta_v", "inverse", "reconstruct", "presets", "crash3")
+MODEL_MODULES = ("particle", "planar", "delta_v", "inverse", "reconstruct", "presets", "crash3", "report")
 ROOT = Path(__file__).resolve().parent.parent
 
 

@@ -34,7 +34,7 @@ r1n, r1t, r2n, r2t = real("r1n r1t r2n r2t")
 Cnn, Cnt, Ctt, Cnm, Ctm, Cmm = real("Cnn Cnt Ctt Cnm Ctm Cmm")
 Knn, Knt, Ktt, hn, ht, am = real("Knn Knt Ktt hn ht am")
 drx, dry, drn, drt, r12, kk, jbar, wa, wb, wc = real("drx dry drn drt r12 kk jbar wa wb wc")
-bn, bt, D, Dc, s, c1, c2, cd, qy = real("bn bt D Dc s c1 c2 cd qy")
+bn, bt, D, Dc, s, c1, c2, cd = real("bn bt D Dc s c1 c2 cd")
 
 
 def _perp(rn, rt):
@@ -193,14 +193,16 @@ def lever_products_sticking():
 
 def yaw_changes():
     """W1 - w1 = j1 (c1 + M) and W2 - w2 = -j2 (c2 + M) with M = am·s written
-    out: with qy = j1 c1 + j2 c2,
-        W1 - w1 =  (e_m qy + (1 - e_m) wr)·j1/(j1 + j2) + jbar·cd,
-        W2 - w2 = -(e_m qy + (1 - e_m) wr)·j2/(j1 + j2) + jbar·cd.
-    No c + M cancellation (M ≈ -c1 at e_m = 0), and the part that survives
-    large inertial weights, jbar·cd, uses cd = (r1 - r2) × P directly."""
+    out as a blend of the two limits of moment restitution:
+        W1 - w1 =  e_m·j1·c1 + (1 - e_m)·(jbar·cd + wr·j1/(j1 + j2)),
+        W2 - w2 = -e_m·j2·c2 + (1 - e_m)·(jbar·cd - wr·j2/(j1 + j2)).
+    e_m = 1 gives exactly j1·c1 (no moment); e_m = 0 the common final yaw rate,
+    where c1 + M would cancel (M ≈ -c1) and only jbar·cd, with cd = (r1 - r2) × P
+    formed directly, survives large inertial weights."""
     jsum = compliance()[2, 2]
-    common = e_m * qy + (1 - e_m) * wr
-    return common * j1 / jsum + jbar * cd, -common * j2 / jsum + jbar * cd
+    common = 1 - e_m
+    return (e_m * j1 * c1 + common * (jbar * cd + wr * j1 / jsum),
+            -e_m * j2 * c2 + common * (jbar * cd - wr * j2 / jsum))
 
 
 def _final_blocks(sticking: bool):
@@ -220,12 +222,12 @@ def _final_blocks(sticking: bool):
                 (TLt, Pt * (gt + gt_final) / 2),
             )
         ),
-        Block(((qy, j1 * c1 + j2 * c2), (V1x, v1x + k1 * Px), (V1y, v1y + k1 * Py),
-               (V2x, v2x - k2 * Px), (V2y, v2y - k2 * Py))),
         Block(
             (
                 # Relative yaw rate at separation if there were no moment impulse.
-                (s, wr - qy),
+                (s, wr - (j1 * c1 + j2 * c2)),
+                (V1x, v1x + k1 * Px), (V1y, v1y + k1 * Py),
+                (V2x, v2x - k2 * Px), (V2y, v2y - k2 * Py),
                 (W1, w1 + dw1), (W2, w2 + dw2),
             )
         ),
