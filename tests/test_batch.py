@@ -91,7 +91,7 @@ def test_column_errors_name_the_column():
     with pytest.raises(ValueError, match="^v2y: length 3"):
         impactsym.solve_batch(c)
     with pytest.raises(ValueError, match="^model: unknown model"):
-        impactsym.solve_batch(_rigid(4), model="brach")
+        impactsym.solve_batch(_rigid(4), model="stronge")
 
 
 def test_a_single_scene_compiles_nothing():
