@@ -38,7 +38,7 @@ import sympy as sp
 from . import frame as f
 from . import planar
 from .frame import Pn, Pt, e, gamma, j1, j2, k1, k2, m1, m2
-from .kernel import Block, Guard, Kernel, NotNaN, finite_inputs, positive_or_fixed, real
+from .kernel import Block, Guard, Kernel, finite_inputs, positive_or_fixed, real
 
 A, B, width, alpha, G, E_crush, E = real("A B width alpha G E_crush E")
 DEPTHS = real("C1 C2 C3 C4 C5 C6")

@@ -42,7 +42,7 @@ from .frame import (
 )
 from .kernel import Block, Guard, IsFinite, Kernel, finite_inputs, positive_or_fixed, real
 from .planar import (
-    D, Dc, Knn, Knt, Ktt, bt, c1, c2, hn, ht, kk, r12, r1n, r1t, r2n, r2t,
+    D, Dc, Knn, Knt, Ktt, bn, bt, c1, c2, hn, ht, kk, r12, r1n, r1t, r2n, r2t,
 )
 
 slip, Dcrit = real("slip Dcrit")
@@ -123,27 +123,31 @@ def _frame_blocks():
 
 
 def _impulse_blocks():
-    """K (Pn, Pt) = (gn, (1 - slip)·gt): Gn = 0 and Gt = slip·gt, by Cramer's rule.
-    μ_c is the ratio of the same scene's slip = 0 (common-velocity) impulse."""
+    """K (Pn, Pt) = (bn, bt) = (gn, (1 - slip)·gt): Gn = 0 and Gt = slip·gt, by
+    Cramer's rule. μ_c is the ratio of the same scene's slip = 0 (common-velocity)
+    impulse."""
     keff = {k: v.xreplace(NO_MOMENT) for k, v in planar.effective_compliance().items()
             if k in (Knn, Knt, Ktt)}
     return (
         Block(tuple(keff.items()) + ((D, planar.effective_determinant().xreplace(NO_MOMENT)),
-                                     (bt, (1 - slip) * gt))),
-        Block(((Dc, Ktt * gn - Knt * bt), (Dcrit, Ktt * gn - Knt * gt)),
+                                     (bn, gn), (bt, (1 - slip) * gt))),
+        Block(((Dc, Ktt * bn - Knt * bt), (Dcrit, Ktt * bn - Knt * gt)),
               Guard((sp.Ne(D, 0), sp.Ne(Dc, 0), sp.Ne(Dcrit, 0)), "SINGULAR")),
-        Block(((Pn, Dc / D), (Pt, (Knn * bt - Knt * gn) / D),
-               (mu_used, (Knn * bt - Knt * gn) / Dc), (mu_c, (Knn * gt - Knt * gn) / Dcrit))),
+        Block(((Pn, Dc / D), (Pt, (Knn * bt - Knt * bn) / D),
+               (mu_used, (Knn * bt - Knt * bn) / Dc), (mu_c, (Knn * gt - Knt * bn) / Dcrit))),
     )
 
 
 def _final_blocks():
     """Finals from the impulse (no moment impulse), energy as the work of Pn and Pt:
-    Gn = 0 and Gt = slip·gt, so TLn = Pn·gn/2 and TLt = Pt·(1 + slip)·gt/2."""
+    Gn = 0 and Gt = slip·gt, so TLn = Pn·gn/2 and TLt = Pt·(1 + slip)·gt/2. The
+    lever products c_i = r_i × P come from Cramer's rule (planar.py's sticking
+    form, valid for any right-hand side (bn, bt)), so a small yaw inertia, which
+    turns P nearly parallel to r_i, does not cancel them."""
     px, py = f.to_scene_frame(Pn, Pt)
+    lever1, lever2 = (x.xreplace(NO_MOMENT) for x in planar.lever_products_sticking()[:2])
     return (
-        Block(((Px, px), (Py, py), (c1, planar._cross(r1n, r1t, Pn, Pt)),
-               (c2, planar._cross(r2n, r2t, Pn, Pt)), (M, sp.Integer(0)),
+        Block(((Px, px), (Py, py), (c1, lever1), (c2, lever2), (M, sp.Integer(0)),
                (TLn, Pn * gn / 2), (TLt, Pt * (1 + slip) * gt / 2))),
         Block(((V1x, v1x + k1 * Px), (V1y, v1y + k1 * Py), (V2x, v2x - k2 * Px),
                (V2y, v2y - k2 * Py), (W1, w1 + j1 * c1), (W2, w2 - j2 * c2),
@@ -296,9 +300,26 @@ def _sideswipe_claims():
                 and _zero(knl.expanded(TLn, at) - Pn * (gn0 + 0) / 2)
                 and _zero(knl.expanded(TLt, at) - Pt * (gt0 + slip * gt0) / 2)
                 and sp.expand(knl.expanded(TL - TLn - TLt, at)) == 0))
+    out.append((f"{tag}: the Cramer lever products equal r_i x P at its impulse",
+                _cramer_levers(knl)))
     out.append((f"{tag}: slip = 0 equals rigid_critical at e = 0, e_m = 1 (common velocity)",
                 _sideswipe_is_common_velocity(knl)))
     return out
+
+
+def _cramer_levers(knl: Kernel) -> bool:
+    """Lemma: the kernel's c_i (Cramer's rule) equal r_i × P of its (Pn, Pt), as
+    identities in the impact-frame lever arms, kk, j1, j2 and (bn, bt)."""
+    atoms = frozenset({r1n, r1t, r2n, r2t, kk, j1, j2, bn, bt, r12, D})
+    sub = {r12: r1n * r2t - r1t * r2n}
+
+    def at_atoms(sym):
+        return knl.expanded(sym, atoms).xreplace(sub)
+
+    sub[D] = sp.expand(at_atoms(Knn * Ktt - Knt**2))
+    pn, pt = at_atoms(Pn).xreplace(sub), at_atoms(Pt).xreplace(sub)
+    return all(sp.simplify(at_atoms(c).xreplace(sub) - planar._cross(rn, rt, pn, pt)) == 0
+               for c, rn, rt in ((c1, r1n, r1t), (c2, r2n, r2t)))
 
 
 def _sideswipe_is_common_velocity(knl: Kernel) -> bool:

@@ -2,7 +2,9 @@
 
 Closed forms derived with SymPy (``derive/``) and emitted as numba kernels
 (``generated/``) for the two-particle model and Brach's planar rigid-body model,
-as reviewed in "A Review of Impact Models for Vehicle Collision". Frame, signs
+as reviewed in "A Review of Impact Models for Vehicle Collision", with the
+seed's Limpert, Macmillan and IMPAC models as named presets (``MODELS``), CRASH3
+(``crash3``) and a side-by-side comparison of them all (``compare``). Frame, signs
 and units: conventions.md (n from vehicle 1 toward vehicle 2; P is the impulse
 on vehicle 1; lower case initial, upper case final).
 
@@ -12,18 +14,20 @@ on vehicle 1; lower case initial, upper case final).
 """
 
 from .batch import solve_batch
+from .compare import compare
+from .crash3 import crash3
 from .codes import FLAG_MESSAGES, STATUS_MESSAGES, describe_flags, describe_status
 from .energy import delta_v_from_energy
 from .inverse import invert, invert_batch
 from .reconstruct import reconstruct, reconstruct_batch
 from .result import Result
-from .scene import Impact, Scene, SceneError, Vehicle, load_scene
+from .scene import MODELS, Impact, Scene, SceneError, Vehicle, load_scene
 from .single import solve
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "FLAG_MESSAGES", "STATUS_MESSAGES", "Impact", "Result", "Scene", "SceneError", "Vehicle",
-    "delta_v_from_energy", "describe_flags", "describe_status", "invert", "invert_batch",
+    "FLAG_MESSAGES", "MODELS", "STATUS_MESSAGES", "Impact", "Result", "Scene", "SceneError",
+    "Vehicle", "compare", "crash3", "delta_v_from_energy", "describe_flags", "describe_status", "invert", "invert_batch",
     "reconstruct", "reconstruct_batch", "load_scene", "solve", "solve_batch",
 ]

@@ -22,7 +22,10 @@ if getattr(generated, "IMPACTSYM_GENERATED", None) != "impactsym":
 
 import numpy as np  # noqa: E402
 
-from generated import delta_v, inverse, particle, planar, reconstruct  # noqa: E402
+from generated import (  # noqa: E402
+    crash3, delta_v, inverse, particle, planar, presets, reconstruct, report,
+)
+from generated.presets import COEFFICIENT_INPUTS, PRESETS  # noqa: E402
 
 SERIAL_BELOW = 64
 
@@ -57,6 +60,7 @@ KERNELS = {
     ("rigid", True): _kernel_set(planar, "rigid_critical"),
     ("particle", False): _kernel_set(particle, "particle"),
     ("particle", True): _kernel_set(particle, "particle_critical"),
+    ("impac_sideswipe", False): _kernel_set(presets, "impac_sideswipe"),
 }
 
 DELTA_V = _kernel_set(delta_v, "delta_v_from_energy")
@@ -70,12 +74,31 @@ RECONSTRUCT = _kernel_set(reconstruct, "reconstruct")
 INVERSE_OUTPUTS = ("v1x", "v1y", "w1", "v2x", "v2y", "w2", "Pn", "Pt", "M",
                    "mu_c", "TL", "TLn", "TLt", "TLm")
 
-MODELS = ("rigid", "particle")
+# Kernel families; the model names a scene may give, and the family each
+# selects with its fixed coefficients, are generated.presets.PRESETS.
+MODELS = ("rigid", "particle", "impac_sideswipe")
+INVERSE_MODELS = ("rigid", "particle")
+
+CRASH3_ENERGY = {n: _kernel_set(crash3, f"crash3_energy_{n}") for n in (2, 4, 6)}
+CRASH3_DELTA_V = _kernel_set(crash3, "crash3_delta_v")
+CRASH3_MOMENT_ARM = _kernel_set(crash3, "crash3_moment_arm")
+CRASH3_RADIUS_OF_GYRATION = _kernel_set(crash3, "crash3_radius_of_gyration")
+CRASH3_IMPLIED_PDOF = _kernel_set(crash3, "crash3_implied_pdof")
+KINETIC_ENERGY = _kernel_set(report, "kinetic_energy")
 
 
-def _check_model(model: str) -> None:
-    if model not in MODELS:
-        raise ValueError(f"model: unknown model {model!r} (use one of {', '.join(MODELS)})")
+def _check_model(model: str, models: tuple[str, ...] = MODELS) -> None:
+    if model not in models:
+        raise ValueError(f"model: unknown model {model!r} (use one of {', '.join(models)})")
+
+
+def preset(model: str) -> tuple[str, dict]:
+    """The kernel family of a model name of generated.presets.PRESETS and the
+    coefficients it fixes, by kernel input name (``limpert`` → ``("rigid",
+    {"e": 0.0, "mu": "critical", "e_m": 1.0})``); ValueError if unknown."""
+    _check_model(model, tuple(PRESETS))
+    row = PRESETS[model]
+    return row["kernel"], {COEFFICIENT_INPUTS[k]: v for k, v in row["fixed"].items()}
 
 
 def kernel_for(model: str, critical: bool) -> KernelSet:
@@ -86,7 +109,7 @@ def kernel_for(model: str, critical: bool) -> KernelSet:
 
 def inverse_kernel_for(model: str) -> KernelSet:
     """The inverse kernel (pre-impact from post-impact) of a model."""
-    _check_model(model)
+    _check_model(model, INVERSE_MODELS)
     return INVERSE[model]
 
 

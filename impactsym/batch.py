@@ -75,13 +75,36 @@ def solve_batch(columns, model: str = "rigid"):
     fixed body is ``m = I = inf``. ``mu="critical"`` uses the critical impulse
     ratio (no sliding at separation) for every row; a scalar is broadcast.
 
+    `model` is any model name a scene may give: a preset of the seed's models
+    fills the coefficients it fixes, which the columns must leave out
+    (``"limpert"`` and ``"impac"``: e = 0, μ = μ_c, e_m = 1; ``"macmillan"``:
+    e_m = 1); ``"impac_sideswipe"`` takes a ``slip`` column in place of ``e mu
+    e_m``; ``"brach"`` is ``"rigid"``.
+
     Returns the same kind of mapping with ``V1x V1y W1 V2x V2y W2 Pn Pt M mu
     mu_c TL TLn TLt TLm`` (float64) and ``status`` and ``flags`` (int32): see
     `impactsym.codes` for their meanings.
     """
-    critical = _critical_mode(columns)
-    ks = _kernels.kernel_for(model, critical)
-    return run_columns(ks, columns, OUTPUTS, ("mu",) if critical else ())
+    family, fixed = _kernels.preset(model)
+    merged = _with_fixed(columns, fixed, model) if fixed else columns
+    critical = _critical_mode(merged)
+    ks = _kernels.kernel_for(family, critical)
+    result = run_columns(ks, merged, OUTPUTS, ("mu",) if critical else ())
+    if merged is not columns and _is_dataframe(columns):
+        import pandas as pd
+
+        return pd.DataFrame(result, index=columns.index)
+    return result
+
+
+def _with_fixed(columns, fixed: dict, model: str) -> dict:
+    """The columns plus the coefficients a preset fixes; a column for one of
+    those is an error (it would be silently replaced)."""
+    for name, value in fixed.items():
+        if name in columns:
+            raise ValueError(f"{name}: the {model} model fixes {name} = {value}; "
+                             "leave the column out")
+    return {**{name: columns[name] for name in columns}, **fixed}
 
 
 def _filler(status: np.ndarray, n: int) -> np.ndarray:

@@ -15,6 +15,8 @@ import sys
 from dataclasses import dataclass
 from typing import Callable
 
+from .compare import compare
+from .crash3 import crash3
 from .scene import SceneError
 from .inverse import invert
 from .reconstruct import reconstruct
@@ -76,6 +78,42 @@ def _run_invert(args: argparse.Namespace) -> int:
     return _print_result(invert(args.scene), args.json)
 
 
+def _add_crash3(parser: argparse.ArgumentParser) -> None:
+    """Arguments of ``crash3``: the scene file, ``--json`` and ``--restitution``."""
+    _add_solve(parser)
+    parser.add_argument("--restitution", type=float, default=0.0, metavar="E",
+                        help="restitution e, 0 <= e < 1 (default 0: CRASH3's common velocity)")
+
+
+def _run_crash3(args: argparse.Namespace) -> int:
+    """CRASH3 delta-V from the vehicles' crush tables; print JSON or a table."""
+    return _print_result(crash3(args.scene, restitution=args.restitution), args.json)
+
+
+def _add_compare(parser: argparse.ArgumentParser) -> None:
+    """Arguments of ``compare``: the scene file, one output format, ``--plot``."""
+    parser.add_argument("scene", help="scene file (.json or .toml)")
+    form = parser.add_mutually_exclusive_group()
+    form.add_argument("--json", action="store_true", help="print the comparison as one JSON object")
+    form.add_argument("--markdown", action="store_true", help="print the table as markdown")
+    parser.add_argument("--plot", metavar="OUT.png",
+                        help="also save a bar chart of delta-V and energy loss by model")
+
+
+def _run_compare(args: argparse.Namespace) -> int:
+    """Run the scene through every model its data allow; print the table."""
+    result = compare(args.scene)
+    if args.plot:
+        try:
+            result.plot(args.plot)
+        except ImportError:
+            raise UsageError("--plot needs matplotlib (pip install 'impactsym[plot]')") from None
+    if args.markdown:
+        print(result.markdown())
+        return 0
+    return _print_result(result, args.json)
+
+
 COMMANDS: dict[str, Command] = {
     "solve": Command(
         "solve the impact of a scene (initial motion -> final motion, impulses, energy loss)",
@@ -91,6 +129,17 @@ COMMANDS: dict[str, Command] = {
         "reconstruct pre-impact speeds from post-impact motion and pre-impact headings",
         _add_solve,
         _run_reconstruct,
+    ),
+    "crash3": Command(
+        "CRASH3: delta-V from the vehicles' crush profiles (and the PDOF inconsistency)",
+        _add_crash3,
+        _run_crash3,
+    ),
+    "compare": Command(
+        "run a scene through every model its data allow (Limpert, Macmillan, IMPAC, Brach, "
+        "particle, CRASH3) and tabulate them",
+        _add_compare,
+        _run_compare,
     ),
 }
 

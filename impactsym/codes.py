@@ -24,6 +24,10 @@ status meaning
 9      reconstruction: the headings are collinear (|sin(θ1 - θ2)| < 2^-20), so
        linear momentum does not determine the speeds
 10     reconstruction: a vehicle is fixed (its momentum is undefined)
+11     CRASH3: a crush input is out of range (A < 0, B <= 0, width <= 0 or a
+       negative depth)
+12     CRASH3: the PDOF is more than 45° from the normal of the damaged face,
+       beyond the limit of the 1 + tan²α energy correction
 ====== ======================================================================
 
 ====== ======================================================================
@@ -77,6 +81,10 @@ STATUS_MESSAGES = {
     _codes.STATUS_INVERSE_EM_TOO_SMALL: "moment restitution e_m is zero or below 2^-20 in "
     "magnitude: the final yaw rates do not determine the initial relative yaw rate; give the "
     "pre-impact yaw rates (impactsym reconstruct) or use e_m = 1 (no moment impulse)",
+    _codes.STATUS_BAD_CRUSH: "a CRASH3 crush input is out of range: A must be >= 0, B and "
+    "the width > 0, every depth >= 0",
+    _codes.STATUS_PDOF_BEYOND_LIMIT: "the PDOF is more than 45 degrees from the normal of the "
+    "damaged face: CRASH3's 1 + tan^2(alpha) energy correction is not valid there",
 }
 
 FLAG_MESSAGES = {

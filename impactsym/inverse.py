@@ -45,7 +45,7 @@ def invert(scene: Union[Scene, Mapping, str, Path]) -> Result:
     the INITIAL ones; delta-V is final minus initial."""
     scene = load_scene(scene, kind="inverse")
     values = _inputs(scene)
-    out = _kernels.run_one(_kernels.inverse_kernel_for(scene.model), values,
+    out = _kernels.run_one(_kernels.inverse_kernel_for(scene.family), values,
                            _kernels.INVERSE_OUTPUTS)
     if out["status"] != 0:
         hint = _HINTS.get(out["status"])

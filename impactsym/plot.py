@@ -328,7 +328,7 @@ def _characteristic_length(scene: Scene) -> float:
     for vehicle in scene.vehicles:
         if vehicle.fixed:
             continue
-        if scene.model == "rigid":
+        if scene.uses_yaw:
             sizes.append(_norm(vehicle.impact_point))
         for key in ("length", "width"):
             size = _num(vehicle.extra.get(key))
@@ -342,7 +342,7 @@ def _bodies(scene: Scene, result: Any, centre, size: float) -> list[_Body]:
     """Placement and motion of both bodies."""
     n, t = _frame(scene)
     kind = str(getattr(result, "kind", "solve") or "solve").lower() if result is not None else None
-    rigid = scene.model == "rigid"
+    rigid = scene.uses_yaw
     bodies = []
     for index, vehicle in enumerate(scene.vehicles):
         entry = result.vehicles[index] if result is not None else None
@@ -590,7 +590,7 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
     ax.set_ylim(*ylim)
     ax.set_aspect("equal", adjustable="box")
     ax.grid(True, lw=0.4, alpha=0.5)
-    schematic = " (positions schematic)" if scene.model == "particle" else ""
+    schematic = " (positions schematic)" if not scene.uses_yaw else ""
     ax.set_xlabel(f"x [{length_unit}]{schematic}")
     ax.set_ylabel(f"y [{length_unit}]")
     ax.set_title(title if title is not None else _title(scene, result), fontsize=10)
@@ -610,8 +610,9 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
 def _title(scene: Scene, result: Any) -> str:
     impact = scene.impact
     name = scene.source.name if scene.source is not None else "scene"
-    mu = "μ = μ_c" if impact.critical else f"μ = {float(impact.impulse_ratio):g}"
-    em = f", e_m = {impact.moment_restitution:g}" if scene.model == "rigid" else ""
+    mu = ("μ = μ_c" if impact.critical else f"slip = {impact.slip:g}"
+          if impact.impulse_ratio is None else f"μ = {float(impact.impulse_ratio):g}")
+    em = f", e_m = {impact.moment_restitution:g}" if scene.uses_yaw else ""
     head = f"{name}: {scene.model} model, {scene.units}; e = {impact.restitution:g}, {mu}{em}"
     if result is None:
         return head

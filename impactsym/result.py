@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 from .codes import describe_flags
-from .scene import Scene
+from .scene import Scene, uses_yaw
 
 __all__ = ["Result", "VehicleResult", "UNIT_LABELS", "scene_warnings"]
 
@@ -151,7 +151,7 @@ class Result:
             (f"delta-V y {speed}", one.delta_v[1], two.delta_v[1]),
             (f"|delta-V| {speed}", one.delta_v_magnitude, two.delta_v_magnitude),
         ]
-        return [row for row in rows if self.model == "rigid" or "yaw" not in row[0]]
+        return [row for row in rows if uses_yaw(self.model) or "yaw" not in row[0]]
 
     def _impact_rows(self) -> list[tuple[str, float]]:
         """Impulse, impulse ratio and energy rows: (label with unit, value)."""
@@ -168,22 +168,26 @@ class Result:
             (f"  tangential TLt {energy}", self.TLt),
             (f"  moment TLm {energy}", self.TLm),
         ]
-        return [row for row in rows if self.model == "rigid" or "moment" not in row[0]]
+        return [row for row in rows if uses_yaw(self.model) or "moment" not in row[0]]
 
 
 def scene_warnings(scene: Scene) -> list[str]:
     """Warnings about unusual but accepted scene inputs.
 
-    Restitution outside [0, 1], moment restitution outside [-1, 1] (rigid
-    model), a fixed vehicle given a motion, and the scene's own warnings
-    (unknown keys).
+    Restitution outside [0, 1], moment restitution outside [-1, 1] (models
+    with yaw), IMPAC's sideswipe slip outside [0, 1], a fixed vehicle given a
+    motion, and the scene's own warnings (unknown keys, coefficients the model
+    fixes or does not use).
     """
     impact = scene.impact
     warnings = []
     if not 0.0 <= impact.restitution <= 1.0:
         warnings.append(f"impact.restitution = {impact.restitution:g} is outside [0, 1]")
-    if scene.model == "rigid" and not -1.0 <= impact.moment_restitution <= 1.0:
+    if scene.uses_yaw and not -1.0 <= impact.moment_restitution <= 1.0:
         warnings.append(f"impact.moment_restitution = {impact.moment_restitution:g} is outside [-1, 1]")
+    if impact.slip is not None and not 0.0 <= impact.slip <= 1.0:
+        warnings.append(f"impact.slip = {impact.slip:g} is outside [0, 1]: the final tangential "
+                        "slip would reverse or exceed the initial one")
     for index, vehicle in enumerate(scene.vehicles):
         if vehicle.fixed and (vehicle.velocity != (0.0, 0.0) or vehicle.yaw_rate != 0.0):
             warnings.append(

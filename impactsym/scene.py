@@ -33,15 +33,21 @@ if sys.version_info >= (3, 11):
 else:
     import tomli as tomllib
 
-__all__ = ["SceneError", "Vehicle", "Impact", "Scene", "load_scene", "MODELS", "UNITS"]
+from generated.presets import PRESETS
 
-MODELS = ("rigid", "particle")
+__all__ = ["SceneError", "Vehicle", "Impact", "Scene", "load_scene", "scene_data", "uses_yaw",
+           "MODELS", "UNITS"]
+
+# Model names a scene may give (generated.presets.PRESETS): the general model
+# ("rigid" or "brach"), "particle", and the seed's named models as presets.
+MODELS = tuple(PRESETS)
 UNITS = ("SI", "US")
 CRITICAL = "critical"
 
 _SCENE_KEYS = ("model", "units", "impact", "vehicles")
 _SCENE_METADATA = ("title", "description", "notes", "comment")
-_IMPACT_KEYS = ("normal_angle", "restitution", "impulse_ratio", "moment_restitution")
+_COEFFICIENT_KEYS = ("restitution", "impulse_ratio", "moment_restitution", "slip")
+_IMPACT_KEYS = ("normal_angle",) + _COEFFICIENT_KEYS
 _VEHICLE_KEYS = ("name", "mass", "yaw_inertia", "velocity", "yaw_rate", "impact_point", "fixed")
 
 
@@ -104,13 +110,18 @@ class Impact:
     ``normal_angle``: Γ in degrees, as written in the scene.  ``restitution``:
     e.  ``impulse_ratio``: signed μ = Pt/Pn, or ``"critical"`` for μ = μ_c (no
     sliding at separation).  ``moment_restitution``: e_m (1 gives no moment
-    impulse).
+    impulse).  ``slip``: IMPAC's sideswipe constraint, the fraction of the
+    initial tangential relative velocity at the impact centre left at
+    separation.  A coefficient the scene's model fixes holds the fixed value
+    (``limpert``: e = 0, ``"critical"``, e_m = 1); one the model does not use is
+    ``None``.
     """
 
     normal_angle: float
-    restitution: float
-    impulse_ratio: Union[float, str]
-    moment_restitution: float = 1.0
+    restitution: float | None
+    impulse_ratio: Union[float, str, None]
+    moment_restitution: float | None = 1.0
+    slip: float | None = None
 
     @property
     def critical(self) -> bool:
@@ -118,13 +129,15 @@ class Impact:
         return self.impulse_ratio == CRITICAL
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``impact`` table in scene-file form."""
-        return {
+        """The ``impact`` table in scene-file form (unused coefficients left out)."""
+        entry = {
             "normal_angle": self.normal_angle,
             "restitution": self.restitution,
             "impulse_ratio": self.impulse_ratio,
             "moment_restitution": self.moment_restitution,
+            "slip": self.slip,
         }
+        return {key: value for key, value in entry.items() if value is not None}
 
 
 @dataclass(frozen=True)
@@ -155,28 +168,43 @@ class Scene:
         data.update(self.extra)
         return data
 
-    def to_inputs(self) -> tuple[str, bool, dict[str, float]]:
-        """Kernel inputs ``(model, critical, values)``.
+    @property
+    def family(self) -> str:
+        """The kernel family that solves the scene's model: ``"rigid"``,
+        ``"particle"`` or ``"impac_sideswipe"`` (generated.presets.PRESETS)."""
+        return PRESETS[self.model]["kernel"]
 
+    @property
+    def uses_yaw(self) -> bool:
+        """True when the model has yaw rates and lever arms (all but particles)."""
+        return uses_yaw(self.model)
+
+    def to_inputs(self) -> tuple[str, bool, dict[str, float]]:
+        """Kernel inputs ``(family, critical, values)``.
+
+        ``family`` is the kernel family of the scene's model (a preset such as
+        ``limpert`` is the ``rigid`` family with its coefficients fixed).
         ``values`` uses the batch names of ``conventions.md``: ``gamma`` is Γ in
         radians, a fixed vehicle has ``m = I = inf``.  The particle model gets
-        only ``m1 m2 v1x v1y v2x v2y gamma e mu``.  With a critical impulse
-        ratio ``mu`` is a placeholder 0.0, which the kernel ignores.
+        only ``m1 m2 v1x v1y v2x v2y gamma e mu``, IMPAC's sideswipe ``slip``
+        in place of ``e mu e_m``.  With a critical impulse ratio ``mu`` is a
+        placeholder 0.0, which the kernel ignores.
         """
         impact = self.impact
-        values = {
-            "gamma": math.radians(impact.normal_angle),
-            "e": impact.restitution,
-            "mu": 0.0 if impact.critical else float(impact.impulse_ratio),
-        }
-        for number, vehicle in enumerate(self.vehicles, start=1):
-            values.update(_vehicle_inputs(vehicle, number, self.model))
-        if self.model == "rigid":
+        values = {"gamma": math.radians(impact.normal_angle)}
+        if self.family == "impac_sideswipe":
+            values["slip"] = impact.slip
+        else:
+            values["e"] = impact.restitution
+            values["mu"] = 0.0 if impact.critical else float(impact.impulse_ratio)
+        if self.family == "rigid":
             values["e_m"] = impact.moment_restitution
-        return self.model, impact.critical, values
+        for number, vehicle in enumerate(self.vehicles, start=1):
+            values.update(_vehicle_inputs(vehicle, number, self.uses_yaw))
+        return self.family, impact.critical, values
 
 
-KINDS = ("forward", "inverse", "reconstruct")
+KINDS = ("forward", "inverse", "reconstruct", "crash3")
 
 
 def load_scene(source: Union[Scene, Mapping, str, Path], kind: str = "forward") -> Scene:
@@ -185,9 +213,11 @@ def load_scene(source: Union[Scene, Mapping, str, Path], kind: str = "forward") 
     ``source`` is a :class:`Scene` (validated again), a mapping in scene-file
     form, or the path of a ``.json`` or ``.toml`` file.  ``kind`` says what the
     scene is for: ``"forward"`` (initial motion given), ``"inverse"`` (final
-    motion given instead: ``final_velocity``, ``final_yaw_rate``) or
+    motion given instead: ``final_velocity``, ``final_yaw_rate``),
     ``"reconstruct"`` (final motion and pre-impact ``heading``; the impact needs
-    only ``normal_angle``).  Raises :class:`SceneError` for a bad scene and
+    only ``normal_angle``) or ``"crash3"`` (each moving vehicle carries ``crush``;
+    the motion, yaw inertia and impact point are optional, the impact needs only
+    ``normal_angle``).  Raises :class:`SceneError` for a bad scene and
     :class:`OSError` for a file that cannot be read.
     """
     if kind not in KINDS:
@@ -200,6 +230,17 @@ def load_scene(source: Union[Scene, Mapping, str, Path], kind: str = "forward") 
         path = Path(source)
         return _parse_scene(_read_file(path), path, kind)
     raise TypeError(f"load_scene: expected a Scene, a mapping or a path, got {type(source).__name__}")
+
+
+def scene_data(source: Union[Scene, Mapping, str, Path]) -> Mapping:
+    """The scene-file mapping of ``source`` (a :class:`Scene`, a mapping or a
+    ``.json``/``.toml`` path), not validated: what a scene gives, before its
+    model's defaults and fixed coefficients are applied."""
+    if isinstance(source, Scene):
+        return source.to_dict()
+    if isinstance(source, Mapping):
+        return source
+    return _read_file(Path(source))
 
 
 def _read_file(path: Path) -> Any:
@@ -231,33 +272,68 @@ def _parse_scene(data: Any, source: Path | None, kind: str) -> Scene:
     model = _choice(data.get("model", "rigid"), "model", MODELS, "model")
     units = _choice(_require(data, "units", ""), "units", UNITS, "units")
     impact_data = _mapping(_require(data, "impact", ""), "impact")
-    impact = _parse_impact(impact_data, kind)
+    if kind == "inverse" and PRESETS[model]["kernel"] not in ("rigid", "particle"):
+        raise SceneError(f"the {model} model has no inverse solution", "model")
+    impact = _parse_impact(impact_data, kind, model)
     vehicles = _parse_vehicles(_require(data, "vehicles", ""), model, kind)
     extra = {key: data[key] for key in data if key not in _SCENE_KEYS}
     warnings = _ignored(extra, "", _SCENE_METADATA)
     warnings += _ignored(impact_data, "impact", _IMPACT_KEYS)
+    if kind in ("forward", "inverse"):
+        warnings += _unused_coefficients(impact_data, model)
     for index, vehicle in enumerate(vehicles):
         warnings += _ignored(vehicle.extra, f"vehicles[{index}]", _VEHICLE_EXTRAS)
     return Scene(model, units, impact, vehicles, source, extra, tuple(warnings))
 
 
-def _parse_impact(data: Mapping, kind: str) -> Impact:
-    """Validate the ``impact`` table. A reconstruction infers the coefficients,
-    so it needs only ``normal_angle``; an inverse needs a numeric impulse ratio."""
+def _parse_impact(data: Mapping, kind: str, model: str) -> Impact:
+    """Validate the ``impact`` table. A reconstruction infers the coefficients
+    and CRASH3 uses none, so they need only ``normal_angle``; an inverse needs
+    a numeric impulse ratio. The model's preset says which coefficients the
+    scene gives and which it fixes."""
     normal_angle = _number(_require(data, "normal_angle", "impact"), "impact.normal_angle")
-    if kind == "reconstruct":
+    if kind in ("reconstruct", "crash3"):
         return Impact(normal_angle=normal_angle, restitution=math.nan, impulse_ratio=math.nan,
                       moment_restitution=math.nan)
-    ratio = _impulse_ratio(_require(data, "impulse_ratio", "impact"))
-    if kind == "inverse" and ratio == CRITICAL:
+    coefficients = {key: _coefficient(data, key, PRESETS[model]) for key in _COEFFICIENT_KEYS}
+    if kind == "inverse" and coefficients["impulse_ratio"] == CRITICAL:
         raise SceneError('must be a number for an inverse solution: with "critical" the final '
                          "velocities do not determine the tangential slip", "impact.impulse_ratio")
-    return Impact(
-        normal_angle=normal_angle,
-        restitution=_number(_require(data, "restitution", "impact"), "impact.restitution"),
-        impulse_ratio=ratio,
-        moment_restitution=_number(data.get("moment_restitution", 1.0), "impact.moment_restitution"),
-    )
+    return Impact(normal_angle=normal_angle, **coefficients)
+
+
+def _coefficient(data: Mapping, key: str, preset: Mapping) -> Any:
+    """One impact coefficient of a model: its fixed value, the scene's (required
+    or optional with a default), or ``None`` when the model does not use it."""
+    if key in preset["fixed"]:
+        return preset["fixed"][key]
+    check = _impulse_ratio if key == "impulse_ratio" else (lambda v: _number(v, f"impact.{key}"))
+    if key in preset["required"]:
+        return check(_require(data, key, "impact"))
+    if key in preset["optional"]:
+        return check(data.get(key, preset["optional"][key]))
+    return None
+
+
+def _unused_coefficients(data: Mapping, model: str) -> list[str]:
+    """Warnings for coefficients the scene gives but its model fixes or does not use."""
+    preset = PRESETS[model]
+    warnings = []
+    for key in _COEFFICIENT_KEYS:
+        if key not in data:
+            continue
+        if key in preset["fixed"] and data[key] != preset["fixed"][key]:
+            warnings.append(f"impact.{key} = {_show(data[key])} is not used: the {model} model "
+                            f"fixes it at {_show(preset['fixed'][key])}")
+        elif key not in preset["fixed"] and key not in (*preset["required"], *preset["optional"]):
+            warnings.append(f"impact.{key} is not used by the {model} model")
+    return warnings
+
+
+def uses_yaw(model: str) -> bool:
+    """True for a model with yaw rates and lever arms (every kernel family but
+    the particle one)."""
+    return PRESETS[model]["kernel"] != "particle"
 
 
 def _impulse_ratio(value: Any) -> Union[float, str]:
@@ -294,7 +370,7 @@ def _parse_vehicle(raw: Any, index: int, model: str, kind: str) -> Vehicle:
     path = f"vehicles[{index}]"
     data = _mapping(raw, path)
     fixed = _flag(data.get("fixed", False), f"{path}.fixed")
-    rigid = model == "rigid"
+    rigid = uses_yaw(model) and kind != "crash3"
     for key in _KIND_KEYS[kind]:
         if not fixed:
             _require(data, key, path)
@@ -317,6 +393,7 @@ _KIND_KEYS = {
     "forward": (),
     "inverse": ("final_velocity",),
     "reconstruct": ("final_velocity", "heading"),
+    "crash3": ("crush",),
 }
 
 
@@ -331,14 +408,15 @@ def _vehicle_extra(data: Mapping, path: str) -> dict[str, Any]:
     return extra
 
 
-def _vehicle_inputs(vehicle: Vehicle, number: int, model: str) -> dict[str, float]:
-    """Batch-named inputs of vehicle ``number`` (1 or 2)."""
+def _vehicle_inputs(vehicle: Vehicle, number: int, yaw: bool) -> dict[str, float]:
+    """Batch-named inputs of vehicle ``number`` (1 or 2); ``yaw``: with yaw
+    inertia, yaw rate and impact point (every model but particles)."""
     values = {
         f"m{number}": math.inf if vehicle.fixed else vehicle.mass,
         f"v{number}x": vehicle.velocity[0],
         f"v{number}y": vehicle.velocity[1],
     }
-    if model == "rigid":
+    if yaw:
         values[f"I{number}"] = math.inf if vehicle.fixed else vehicle.yaw_inertia
         values[f"w{number}"] = vehicle.yaw_rate
         values[f"r{number}x"] = vehicle.impact_point[0]

@@ -11,7 +11,7 @@ import pytest
 import sympy as sp
 
 from derive import __main__ as derive_main
-from derive import delta_v, emit, frame, inverse, particle, planar, reconstruct
+from derive import crash3, delta_v, emit, frame, inverse, particle, planar, presets, reconstruct, report
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -21,7 +21,8 @@ def _run_derive(*args, cwd=ROOT):
                           capture_output=True, text=True, timeout=300)
 
 
-@pytest.mark.parametrize("module", [particle, planar, delta_v, inverse, reconstruct], ids=lambda m: m.__name__)
+@pytest.mark.parametrize("module", [particle, planar, delta_v, inverse, reconstruct, presets, crash3,
+                                    report], ids=lambda m: m.__name__)
 def test_every_proof_passes(module):
     failed = [claim for claim, ok in module.proofs() if not ok]
     assert not failed, f"failed proofs: {failed}"
@@ -88,3 +89,12 @@ def test_runtime_never_imports_sympy_or_derive():
     proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
                           text=True, timeout=120, env={**os.environ, "PYTHONPATH": ""})
     assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
+@pytest.mark.parametrize("expr", ["x/y**2", "x*z/y**2", "1/(1 + (x/y)**2)", "x/(y + z)**2", "-x/y**2"])
+def test_a_squared_denominator_keeps_its_parentheses(expr):
+    """x/y**2 must print as x/(y*y), never x/y*y (which is x)."""
+    e = sp.sympify(expr)
+    values = {"x": 2.0, "y": 3.0, "z": 5.0}
+    assert eval(emit.code(e), {"math": __import__("math"), **values}) == pytest.approx(
+        float(e.subs(values)), rel=1e-15)

@@ -1,0 +1,293 @@
+"""Every model of the seed on one scene, side by side (the seed's Tables 5-8).
+
+:func:`compare` runs a forward scene through each model its data allow:
+
+- ``brach`` (the general model) and ``macmillan`` (e_m = 1) need the scene's
+  restitution and impulse ratio; ``particle`` too (it ignores yaw and lever arms);
+- ``limpert`` and ``impac`` (common velocity) need only the geometry; they
+  coincide by construction (seed Table 7);
+- ``impac_sideswipe`` runs when the scene gives ``impact.slip`` (at slip = 0 it
+  is ``impac``);
+- ``crash3`` runs when every moving vehicle carries a ``crush`` table (its
+  restitution is 0: common velocity).
+
+Each row gives the final velocity of each vehicle as speed and direction
+(degrees counter-clockwise from +x), the final yaw rate, delta-V, and the energy
+loss with its normal, tangential and moment parts, also as a percent of the
+initial kinetic energy (translational plus yaw). CRASH3 has no yaw rates and
+no energy parts (crush measures the normal deformation only); its final
+velocities are the initial ones plus its delta-V along the entered PDOFs.
+A model the data do not allow is listed in ``skipped`` with the reason.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Union
+
+from generated.presets import PRESETS
+
+from . import _kernels
+from .crash3 import crash3
+from .result import UNIT_LABELS, Result
+from .scene import Scene, SceneError, load_scene, scene_data, uses_yaw
+from .single import solve
+
+__all__ = ["compare", "Comparison", "ModelRow", "COMPARED_MODELS"]
+
+COMPARED_MODELS = ("brach", "macmillan", "limpert", "impac", "impac_sideswipe", "particle", "crash3")
+CRASH3_ASSUMPTIONS = ("CRASH3 (McHenry): |delta-V| from the crush energy with a common velocity "
+                      "at the impact centre (e = 0, mu = mu_max); its direction from the entered "
+                      "PDOF; no yaw.")
+_ENERGY_PARTS = ("total", "normal", "tangential", "moment")
+
+
+@dataclass(frozen=True)
+class VehicleRow:
+    """One vehicle in one model: final velocity [m/s | ft/s] and its speed and
+    direction [deg], final yaw rate [rad/s] (None: the model has none), delta-V."""
+
+    velocity: tuple[float, float]
+    speed: float
+    direction: float
+    yaw_rate: float | None
+    delta_v: tuple[float, float]
+    delta_v_magnitude: float
+
+    def to_json_dict(self) -> dict[str, Any]:
+        """The vehicle entry of a model in ``compare --json``."""
+        return {"velocity": list(self.velocity), "speed": self.speed, "direction": self.direction,
+                "yaw_rate": self.yaw_rate, "delta_v": list(self.delta_v),
+                "delta_v_magnitude": self.delta_v_magnitude}
+
+
+@dataclass(frozen=True)
+class ModelRow:
+    """One model's outcome: vehicles, energy loss [J | ft·lb] by part (None for
+    a part the model does not have) and as a percent of the initial kinetic
+    energy, the impulse ratio used and the critical one (None for CRASH3)."""
+
+    model: str
+    assumptions: str
+    vehicles: tuple[VehicleRow, VehicleRow]
+    energy: dict[str, float | None]
+    energy_percent: dict[str, float | None]
+    mu: float | None
+    mu_c: float | None
+    warnings: list[str] = field(default_factory=list)
+
+    def to_json_dict(self) -> dict[str, Any]:
+        """One model's entry in ``compare --json``."""
+        return {"model": self.model, "assumptions": self.assumptions,
+                "vehicles": [v.to_json_dict() for v in self.vehicles],
+                "energy_loss": dict(self.energy), "energy_loss_percent": dict(self.energy_percent),
+                "impulse_ratio": self.mu, "critical_impulse_ratio": self.mu_c,
+                "warnings": list(self.warnings)}
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """Every model the scene allows, with the initial kinetic energy [J | ft·lb]."""
+
+    units: str
+    names: tuple[str, str]
+    initial_kinetic_energy: float
+    rows: tuple[ModelRow, ...]
+    skipped: dict[str, str]
+
+    def to_json_dict(self) -> dict[str, Any]:
+        """The object printed by ``impactsym compare --json``."""
+        return {"units": self.units, "vehicle_names": list(self.names),
+                "initial_kinetic_energy": self.initial_kinetic_energy,
+                "models": [row.to_json_dict() for row in self.rows],
+                "skipped": dict(self.skipped)}
+
+    def _cells(self) -> tuple[list[str], list[list[str]]]:
+        """Column headers and one list of cells per model."""
+        labels = UNIT_LABELS[self.units]
+        v, w = labels["velocity"], labels["yaw_rate"]
+        headers = ["model"]
+        for name in self.names:
+            headers += [f"{name}: V [{v}] / dir", f"W [{w}]", f"|dV| [{v}]"]
+        headers += ["TL %", "TLn %", "TLt %", "TLm %"]
+        body = []
+        for row in self.rows:
+            cells = [row.model]
+            for veh in row.vehicles:
+                cells += [f"{veh.speed:.2f} / {veh.direction:.1f}°", _cell(veh.yaw_rate, ".2f"),
+                          _cell(veh.delta_v_magnitude, ".2f")]
+            cells += [_cell(row.energy_percent[part], ".1f") for part in _ENERGY_PARTS]
+            body.append(cells)
+        return headers, body
+
+    def table(self) -> str:
+        """A plain-text table for people (like the seed's Tables 5-8)."""
+        headers, body = self._cells()
+        widths = [max(len(h), *(len(r[i]) for r in body)) for i, h in enumerate(headers)]
+        lines = [f"model comparison, {self.units} units; energy as % of the initial kinetic "
+                 f"energy {self.initial_kinetic_energy:.6g} {UNIT_LABELS[self.units]['energy']}",
+                 ""]
+        for cells in [headers] + body:
+            lines.append("  ".join(c.rjust(wd) if i else c.ljust(wd)
+                                   for i, (c, wd) in enumerate(zip(cells, widths))))
+        lines += [""] + [f"skipped {name}: {reason}" for name, reason in self.skipped.items()]
+        for row in self.rows:
+            lines += [f"{row.model}: {warning}" for warning in row.warnings]
+        return "\n".join(lines).rstrip("\n")
+
+    def markdown(self) -> str:
+        """The same table as GitHub markdown."""
+        headers, body = self._cells()
+        lines = ["| " + " | ".join(_escape(headers)) + " |", "|" + "---|" * len(headers)]
+        lines += ["| " + " | ".join(_escape(cells)) + " |" for cells in body]
+        lines += [""] + [f"- skipped `{n}`: {reason}" for n, reason in self.skipped.items()]
+        return "\n".join(lines).rstrip("\n")
+
+    def plot(self, path: Union[str, Path]) -> None:
+        """Bar charts of |delta-V| per vehicle and of the energy loss (% of the
+        initial kinetic energy, stacked normal/tangential/moment) by model, saved
+        to `path` (needs matplotlib: ``pip install 'impactsym[plot]'``)."""
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        names = [row.model for row in self.rows]
+        x = list(range(len(names)))
+        fig, (ax_dv, ax_e) = plt.subplots(1, 2, figsize=(11, 4.2))
+        for k, label in enumerate(self.names):
+            ax_dv.bar([i + (k - 0.5) * 0.38 for i in x],
+                      [row.vehicles[k].delta_v_magnitude for row in self.rows], 0.38, label=label)
+        ax_dv.set_ylabel(f"|delta-V| [{UNIT_LABELS[self.units]['velocity']}]")
+        ax_dv.legend()
+        bottom = [0.0] * len(names)
+        for part in ("normal", "tangential", "moment"):
+            heights = [row.energy_percent[part] or 0.0 for row in self.rows]
+            ax_e.bar(x, heights, 0.6, bottom=bottom, label=part)
+            bottom = [b + h for b, h in zip(bottom, heights)]
+        crash = [row.energy_percent["total"] if row.energy_percent["normal"] is None else 0.0
+                 for row in self.rows]
+        ax_e.bar(x, crash, 0.6, label="crush energy (CRASH3)", hatch="//")
+        ax_e.set_ylabel("energy loss [% of initial kinetic energy]")
+        ax_e.margins(y=0.25)
+        ax_e.legend()
+        for ax in (ax_dv, ax_e):
+            ax.set_xticks(x)
+            ax.set_xticklabels(names, rotation=30, ha="right")
+        fig.tight_layout()
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+
+
+def compare(scene: Union[Scene, Mapping, str, Path]) -> Comparison:
+    """Run a forward scene through every model its data allow (see the module
+    docstring). Raises :class:`SceneError` when the scene itself is not a valid
+    forward scene or no model can solve it."""
+    data = scene_data(scene)
+    base = _base_scene(data)
+    initial = _initial_kinetic_energy(base)
+    rows, skipped = [], {}
+    for name in COMPARED_MODELS:
+        try:
+            rows.append(_crash3_row(data, base, initial) if name == "crash3"
+                        else _model_row(data, name, initial))
+        except SceneError as exc:
+            skipped[name] = str(exc)
+    if not rows:
+        raise SceneError("no model can solve this scene: "
+                         + "; ".join(f"{n}: {r}" for n, r in skipped.items()))
+    names = (base.vehicles[0].name, base.vehicles[1].name)
+    return Comparison(base.units, names, initial, tuple(rows), skipped)
+
+
+def _base_scene(data: Mapping) -> Scene:
+    """The scene as given or, when its own model lacks coefficients the other
+    models do not need, as the common-velocity (impac) model reads it."""
+    try:
+        return load_scene(data)
+    except SceneError as exc:
+        try:
+            return load_scene(_variant(data, "impac"))
+        except SceneError:
+            raise exc from None
+
+
+def _variant(data: Mapping, model: str) -> dict:
+    """The scene as the given model reads it: the impact coefficients the model
+    fixes or does not use are left out (so they raise no warnings)."""
+    preset = PRESETS[model]
+    used = ("normal_angle", *preset["required"], *preset["optional"])
+    impact = {k: v for k, v in data["impact"].items() if k in used}
+    return {**data, "model": model, "impact": impact}
+
+
+def _model_row(data: Mapping, model: str, initial: float) -> ModelRow:
+    """One impulse-momentum model's row."""
+    if model == "impac_sideswipe" and "slip" not in data["impact"]:
+        raise SceneError("no impact.slip given (at slip = 0 it is the impac row)")
+    scene = load_scene(_variant(data, model))
+    result: Result = solve(scene)
+    yaw = uses_yaw(model)
+    vehicles = tuple(_vehicle_row(v.velocity, v.yaw_rate if yaw else None, v.delta_v,
+                                  v.delta_v_magnitude) for v in result.vehicles)
+    energy = {"total": result.TL, "normal": result.TLn, "tangential": result.TLt,
+              "moment": result.TLm if yaw else None}
+    return ModelRow(model, PRESETS[model]["assumptions"], vehicles, energy,
+                    _percent(energy, initial), result.mu, result.mu_c,
+                    [w for w in result.warnings if w not in scene.warnings])
+
+
+def _crash3_row(data: Mapping, base: Scene, initial: float) -> ModelRow:
+    """CRASH3's row: delta-V from crush, final velocity = initial + delta-V."""
+    missing = [v.name for v in base.vehicles if not v.fixed and "crush" not in v.extra]
+    if missing:
+        raise SceneError(f"no crush table for {', '.join(missing)}")
+    result = crash3(data)
+    vehicles = tuple(
+        _vehicle_row((v.velocity[0] + c.delta_v[0], v.velocity[1] + c.delta_v[1]), None,
+                     c.delta_v, c.delta_v_magnitude)
+        for v, c in zip(base.vehicles, result.vehicles))
+    energy = {"total": result.energy_total, "normal": None, "tangential": None, "moment": None}
+    return ModelRow("crash3", CRASH3_ASSUMPTIONS, vehicles, energy, _percent(energy, initial),
+                    None, None, [w for w in result.warnings if w not in base.warnings])
+
+
+def _vehicle_row(velocity, yaw_rate, delta_v, magnitude) -> VehicleRow:
+    """Final velocity also as speed and direction (degrees from +x)."""
+    return VehicleRow(velocity=tuple(velocity), speed=math.hypot(*velocity),
+                      direction=math.degrees(math.atan2(velocity[1], velocity[0])),
+                      yaw_rate=yaw_rate, delta_v=tuple(delta_v), delta_v_magnitude=magnitude)
+
+
+def _initial_kinetic_energy(scene: Scene) -> float:
+    """Kinetic energy of the pair before impact (generated report kernel)."""
+    values = {}
+    for number, vehicle in enumerate(scene.vehicles, start=1):
+        values[f"m{number}"] = math.inf if vehicle.fixed else vehicle.mass
+        values[f"I{number}"] = math.inf if vehicle.fixed else (vehicle.yaw_inertia or 0.0)
+        values[f"v{number}x"], values[f"v{number}y"] = vehicle.velocity
+        values[f"w{number}"] = vehicle.yaw_rate if vehicle.yaw_inertia else 0.0
+    ks = _kernels.KINETIC_ENERGY
+    out = _kernels.run_one(ks, values, ks.outputs)
+    if out["status"]:
+        raise SceneError("cannot compute the initial kinetic energy")
+    return out["T"]
+
+
+def _percent(energy: Mapping[str, float | None], initial: float) -> dict[str, float | None]:
+    """Each energy as a percent of the initial kinetic energy (None stays None)."""
+    return {k: None if v is None or initial <= 0.0 else 100.0 * v / initial
+            for k, v in energy.items()}
+
+
+def _escape(cells: list[str]) -> list[str]:
+    """Markdown table cells with their pipes escaped (|dV| in a header)."""
+    return [c.replace("|", "\\|") for c in cells]
+
+
+def _cell(value: float | None, fmt: str) -> str:
+    """A table cell in format `fmt`, or n/a for a quantity the model does not have."""
+    return "n/a" if value is None else format(value + 0.0, fmt)
