@@ -118,3 +118,21 @@ def test_cli_invert_refuses_a_critical_impulse_ratio(tmp_path, capsys):
     path.write_text(json.dumps(scene))
     assert main(["invert", str(path)]) == 2
     assert "impact.impulse_ratio" in capsys.readouterr().err
+
+
+def test_round_trip_on_the_stress_scenes():
+    """invert(forward(x)) = x on the accuracy benchmark's stress rows where the
+    inverse is determined (e, |e_m| >= 0.05) and the forward result is physical."""
+    from benchmarks.sets import stress_set
+
+    columns, families = stress_set()
+    fwd = impactsym.solve_batch(columns)
+    usable = ((fwd["status"] == 0) & (fwd["flags"] == 0) & (columns["e"] >= 0.05)
+              & (np.abs(columns["e_m"]) >= 0.05))
+    assert len(set(families[usable])) >= 5, set(families[usable])
+    inv = impactsym.invert_batch(_finals_as_inputs(columns, fwd, "rigid"))
+    assert (inv["status"][usable] == 0).all()
+    scale = _speed_scale(columns, fwd)[usable]
+    for low in ("v1x", "v1y", "v2x", "v2y"):
+        err = np.abs(inv[low][usable] - columns[low][usable]) / scale
+        assert err.max() <= 1e-12, (low, err.max(), families[usable][np.argmax(err)])
