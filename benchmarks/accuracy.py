@@ -10,10 +10,6 @@ outputs ``V1x V1y W1 V2x V2y W2 Pn Pt M mu mu_c TL TLn TLt TLm``):
 * ``fastmath``, ``float32``: the same closed forms rendered by the project's emitter
   with ``derive.emit.VARIANTS["fastmath"]`` / ``["float32"]`` (float32 inputs and
   outputs);
-* ``float32 strict``: the float32 style with this benchmark's one-line printer fix
-  (``1/x`` printed as ``np.float32(1.0)/x``; the emitter's float32 style prints
-  ``1.0/x``, a float64 literal, so everything after the inverse masses runs in
-  float64);
 * ``KE difference``: ``derive.planar.ke_difference_kernel()`` (TL as kinetic energy
   before minus after), default style;
 * ``linear solve``: the 9x9 system of conventions.md assembled with NumPy for all
@@ -84,35 +80,15 @@ _TMP: tempfile.TemporaryDirectory | None = None
 _VARIANTS: dict[str, object] = {}
 
 
-def _strict_float32_style():
-    """The emitter's float32 style, but with ``1/x`` printed as a float32 division."""
-    from sympy.printing.precedence import PRECEDENCE
-
-    from derive import emit
-
-    base = emit.VARIANTS["float32"]
-
-    class StrictFloat32Printer(type(base.printer)):
-        def _print_Pow(self, expr, rational=False):
-            if expr.exp == -1:
-                return f"np.float32(1.0)/{self.parenthesize(expr.base, PRECEDENCE['Pow'])}"
-            return super()._print_Pow(expr, rational=rational)
-
-    settings = getattr(emit, "_SETTINGS", {"fully_qualified_modules": True, "standard": "python3"})
-    return emit.Style(base.jit_options, StrictFloat32Printer(dict(settings)), base.imports)
-
-
 def variant_source(kind: str) -> tuple[str, str]:
     """``(text, kernel name)`` of a variant module rendered by ``derive.emit``:
-    ``kind`` is ``"fastmath"``, ``"float32"``, ``"float32_strict"`` or
+    ``kind`` is ``"fastmath"``, ``"float32"`` or
     ``"ke_difference"`` (the naive-energy kernel, default style)."""
     from derive import emit, planar
 
     doc = (planar.__doc__ or "").strip().splitlines()[0]
     if kind == "ke_difference":
         kernels, style = [planar.ke_difference_kernel()], emit.DEFAULT
-    elif kind == "float32_strict":
-        kernels, style = list(planar.KERNELS[:1]), _strict_float32_style()
     else:
         kernels, style = list(planar.KERNELS[:1]), emit.VARIANTS[kind]
     text = emit.render_module("planar.py", doc, kernels, emit.source_hash(), style)
@@ -291,11 +267,7 @@ def build_methods() -> list[Method]:
         ("fastmath", "fastmath", np.float64,
          'same formulas, `derive.emit.VARIANTS["fastmath"]` (`fastmath=True`)'),
         ("float32", "float32", np.float32,
-         '`derive.emit.VARIANTS["float32"]`, float32 inputs and outputs; the style prints '
-         "`1.0/m1` (a float64 literal), so from the inverse masses on it computes in float64"),
-        ("float32_strict", "float32 strict", np.float32,
-         "the float32 style with `1/x` printed as `np.float32(1.0)/x` (this benchmark's "
-         "printer fix): float32 arithmetic throughout"),
+         '`derive.emit.VARIANTS["float32"]`: float32 inputs, literals, arithmetic and outputs'),
         ("ke_difference", "KE difference", np.float64,
          "`derive.planar.ke_difference_kernel()`: TL = kinetic energy before - after "
          "(the other outputs are the default's)"),
