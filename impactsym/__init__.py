@@ -17,7 +17,9 @@ from .batch import solve_batch
 from .compare import compare
 from .crash3 import crash3
 from .codes import FLAG_MESSAGES, STATUS_MESSAGES, describe_flags, describe_status
+from . import plot
 from .energy import delta_v_from_energy
+from .explore import explore
 from .inverse import invert, invert_batch
 from .reconstruct import reconstruct, reconstruct_batch
 from .result import Result
@@ -28,6 +30,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "FLAG_MESSAGES", "MODELS", "STATUS_MESSAGES", "Impact", "Result", "Scene", "SceneError",
-    "Vehicle", "compare", "crash3", "delta_v_from_energy", "describe_flags", "describe_status", "invert", "invert_batch",
-    "reconstruct", "reconstruct_batch", "load_scene", "solve", "solve_batch",
+    "Vehicle", "compare", "crash3", "delta_v_from_energy", "describe_flags", "describe_status",
+    "explore", "invert", "invert_batch", "load_scene", "plot", "reconstruct", "reconstruct_batch",
+    "solve", "solve_batch",
 ]

@@ -19,6 +19,7 @@ from .compare import compare
 from .crash3 import crash3
 from .scene import SceneError
 from .inverse import invert
+from .plot import add_plot_argument, save_plot
 from .reconstruct import reconstruct
 from .single import solve
 
@@ -48,10 +49,17 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
-def _add_solve(parser: argparse.ArgumentParser) -> None:
-    """Arguments of ``solve``: the scene file and ``--json``."""
+def _add_scene(parser: argparse.ArgumentParser) -> None:
+    """The scene file and ``--json``."""
     parser.add_argument("scene", help="scene file (.json or .toml)")
     parser.add_argument("--json", action="store_true", help="print the result as one JSON object")
+
+
+def _add_solve(parser: argparse.ArgumentParser) -> None:
+    """Arguments of ``solve``, ``invert``, ``reconstruct``: the scene, ``--json``,
+    ``--plot PATH`` (the scene diagram)."""
+    _add_scene(parser)
+    add_plot_argument(parser)
 
 
 def _print_result(result, as_json: bool) -> int:
@@ -63,24 +71,31 @@ def _print_result(result, as_json: bool) -> int:
     return 0
 
 
+def _report(result, args: argparse.Namespace) -> int:
+    """Draw the scene diagram (``--plot``), then print the result."""
+    if args.plot:
+        save_plot(result, args.plot, scene=args.scene)
+    return _print_result(result, args.json)
+
+
 def _run_solve(args: argparse.Namespace) -> int:
     """Solve a scene; print JSON (``--json``) or a table."""
-    return _print_result(solve(args.scene), args.json)
+    return _report(solve(args.scene), args)
 
 
 def _run_reconstruct(args: argparse.Namespace) -> int:
     """Reconstruct pre-impact speeds from final motion and headings; print JSON or a table."""
-    return _print_result(reconstruct(args.scene), args.json)
+    return _report(reconstruct(args.scene), args)
 
 
 def _run_invert(args: argparse.Namespace) -> int:
     """Recover the pre-impact motion of an inverse scene; print JSON or a table."""
-    return _print_result(invert(args.scene), args.json)
+    return _report(invert(args.scene), args)
 
 
 def _add_crash3(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``crash3``: the scene file, ``--json`` and ``--restitution``."""
-    _add_solve(parser)
+    _add_scene(parser)
     parser.add_argument("--restitution", type=float, default=0.0, metavar="E",
                         help="restitution e, 0 <= e < 1 (default 0: CRASH3's common velocity)")
 

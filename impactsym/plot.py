@@ -215,7 +215,12 @@ def _resolve(obj: Any, scene: Optional[SceneLike], result: Any) -> tuple[Scene, 
                 "(the scene file or Scene it was solved from)")
     if result is not None and not hasattr(result, "vehicles"):
         raise TypeError(f"plot: expected a result with vehicles, got {type(result).__name__}")
-    return load_scene(scene), result, _impact_position(scene)
+    kind = _SCENE_KINDS.get(str(getattr(result, "kind", "solve")), "forward")
+    return load_scene(scene, kind=kind), result, _impact_position(scene)
+
+
+#: Which scene kind (load_scene) a result kind was solved from.
+_SCENE_KINDS = {"solve": "forward", "invert": "inverse", "reconstruct": "reconstruct"}
 
 
 def _impact_position(source: SceneLike) -> tuple[float, float]:
@@ -614,6 +619,9 @@ def _title(scene: Scene, result: Any) -> str:
           if impact.impulse_ratio is None else f"μ = {float(impact.impulse_ratio):g}")
     em = f", e_m = {impact.moment_restitution:g}" if scene.uses_yaw else ""
     head = f"{name}: {scene.model} model, {scene.units}; e = {impact.restitution:g}, {mu}{em}"
+    if getattr(result, "kind", None) == "reconstruct":
+        head = (f"{name}: reconstruction, {scene.units}; implied e = {result.e:.3g}, "
+                f"e_m = {result.e_m:.3g}")
     if result is None:
         return head
     energy = UNIT_LABELS[scene.units]["energy"]

@@ -80,6 +80,7 @@ class Reconstruction:
     TLm: float
     flags: int
     warnings: list[str] = field(default_factory=list)
+    kind = "reconstruct"
 
     def to_json_dict(self) -> dict[str, Any]:
         """The object printed by ``impactsym reconstruct --json`` (conventions.md)."""

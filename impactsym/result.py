@@ -79,6 +79,11 @@ class Result:
     warnings: list[str] = field(default_factory=list)
     direction: str = "forward"
 
+    @property
+    def kind(self) -> str:
+        """The command that made it: ``"solve"`` or ``"invert"``."""
+        return "solve" if self.direction == "forward" else "invert"
+
     @classmethod
     def from_kernel(cls, scene: Scene, out: Mapping[str, Any]) -> "Result":
         """Combine a scene with the output of ``_kernels.solve_one`` (status 0)."""

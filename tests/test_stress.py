@@ -711,7 +711,12 @@ def stress_mix(draw):
     return dict(seed=seed, n=n, mass=draw(row_floats(-9, 9)), inertia1=draw(row_floats(-8, 8)),
                 inertia2=draw(row_floats(-8, 8)), speed=draw(row_floats(-6, 6)),
                 e=draw(row_pick([0.0, 0.25, 0.5, 1.0 - 2.0**-20, 1.0])),
-                e_m=draw(row_pick(list(EM_MAIN))), frac=draw(row_floats(0.0, 1.0)),
+                # μ strictly below μ_c: exactly at μ_c with a yaw inertia near 1e-8 of
+                # the usual the sliding problem itself is ill-conditioned in μ (one ulp
+                # of μ moves the 50-digit answer by ~5e-9, measured for seed 88974308),
+                # so no float64 method can meet 1e-12 there. μ = μ_c with ordinary
+                # inertias is covered by test_mu_at_and_below_critical.
+                e_m=draw(row_pick(list(EM_MAIN))), frac=draw(row_floats(0.0, 0.999)),
                 critical=draw(st.booleans()), barrier=draw(st.booleans()))
 
 
