@@ -18,7 +18,7 @@ from typing import Any, Union
 from . import _kernels
 from .batch import run_columns
 from .codes import describe_flags, describe_status
-from .result import UNIT_LABELS, _finite, _num
+from .result import UNIT_LABELS, json_number, table_cell
 from .scene import Scene, SceneError, load_scene
 
 OUTPUTS = ("s1", "s2", "v1x", "v1y", "v2x", "v2y", "Pn", "Pt", "M", "M_residual",
@@ -51,11 +51,11 @@ class ReconstructedVehicle:
     pdof_clock: int
 
     def to_json_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "speed": _finite(self.speed),
-                "velocity": [_finite(v) for v in self.velocity],
-                "delta_v": [_finite(v) for v in self.delta_v],
-                "delta_v_magnitude": _finite(self.delta_v_magnitude),
-                "pdof_deg": _finite(self.pdof_deg), "pdof_clock": self.pdof_clock}
+        return {"name": self.name, "speed": json_number(self.speed),
+                "velocity": [json_number(v) for v in self.velocity],
+                "delta_v": [json_number(v) for v in self.delta_v],
+                "delta_v_magnitude": json_number(self.delta_v_magnitude),
+                "pdof_deg": json_number(self.pdof_deg), "pdof_clock": self.pdof_clock}
 
 
 @dataclass(frozen=True)
@@ -87,15 +87,15 @@ class Reconstruction:
         return {
             "units": self.units,
             "vehicles": [v.to_json_dict() for v in self.vehicles],
-            "impulse": {"normal": _finite(self.Pn), "tangential": _finite(self.Pt),
-                        "moment": _finite(self.M)},
-            "moment_residual": _finite(self.M_residual),
-            "restitution": _finite(self.e),
-            "impulse_ratio": _finite(self.mu),
-            "moment_restitution": _finite(self.e_m),
-            "critical_impulse_ratio": _finite(self.mu_c),
-            "energy_loss": {"total": _finite(self.TL), "normal": _finite(self.TLn),
-                            "tangential": _finite(self.TLt), "moment": _finite(self.TLm)},
+            "impulse": {"normal": json_number(self.Pn), "tangential": json_number(self.Pt),
+                        "moment": json_number(self.M)},
+            "moment_residual": json_number(self.M_residual),
+            "restitution": json_number(self.e),
+            "impulse_ratio": json_number(self.mu),
+            "moment_restitution": json_number(self.e_m),
+            "critical_impulse_ratio": json_number(self.mu_c),
+            "energy_loss": {"total": json_number(self.TL), "normal": json_number(self.TLn),
+                            "tangential": json_number(self.TLt), "moment": json_number(self.TLm)},
             "flags": self.flags,
             "warnings": list(self.warnings),
         }
@@ -114,7 +114,7 @@ class Reconstruction:
                 ("PDOF [o'clock]", one.pdof_clock, two.pdof_clock)]
         lines = [f"reconstruction, {self.units} units", "",
                  f"{'':<28}{one.name:>{width}}{two.name:>{width}}"]
-        lines += [f"{label:<28}{_num(a):>{width}}{_num(b):>{width}}" for label, a, b in rows]
+        lines += [f"{label:<28}{table_cell(a):>{width}}{table_cell(b):>{width}}" for label, a, b in rows]
         lines.append("")
         implied = [("implied restitution e", self.e), ("implied impulse ratio mu", self.mu),
                    ("critical impulse ratio mu_c", self.mu_c),
@@ -123,7 +123,7 @@ class Reconstruction:
                    (f"  consistency residual [{labels['moment']}]", self.M_residual),
                    (f"energy loss TL {energy}", self.TL), (f"  normal TLn {energy}", self.TLn),
                    (f"  tangential TLt {energy}", self.TLt), (f"  moment TLm {energy}", self.TLm)]
-        lines += [f"{label:<36}{_num(value):>14}" for label, value in implied]
+        lines += [f"{label:<36}{table_cell(value):>14}" for label, value in implied]
         lines += ["", "warnings:"] + [f"  - {w}" for w in self.warnings] if self.warnings \
             else ["", "warnings: none"]
         return "\n".join(lines)

@@ -16,7 +16,7 @@ from typing import Any, Mapping
 from .codes import describe_flags
 from .scene import Scene, uses_yaw
 
-__all__ = ["Result", "VehicleResult", "UNIT_LABELS", "scene_warnings"]
+__all__ = ["Result", "VehicleResult", "UNIT_LABELS", "json_number", "scene_warnings", "table_cell"]
 
 UNIT_LABELS = {
     "SI": {"velocity": "m/s", "yaw_rate": "rad/s", "impulse": "N·s", "moment": "N·m·s", "energy": "J"},
@@ -44,10 +44,10 @@ class VehicleResult:
         """The vehicle entry of ``solve --json``."""
         return {
             "name": self.name,
-            "velocity": [_finite(value) for value in self.velocity],
-            "yaw_rate": _finite(self.yaw_rate),
-            "delta_v": [_finite(value) for value in self.delta_v],
-            "delta_v_magnitude": _finite(self.delta_v_magnitude),
+            "velocity": [json_number(value) for value in self.velocity],
+            "yaw_rate": json_number(self.yaw_rate),
+            "delta_v": [json_number(value) for value in self.delta_v],
+            "delta_v_magnitude": json_number(self.delta_v_magnitude),
         }
 
 
@@ -110,14 +110,14 @@ class Result:
             "model": self.model,
             "units": self.units,
             "vehicles": [vehicle.to_json_dict() for vehicle in self.vehicles],
-            "impulse": {"normal": _finite(self.Pn), "tangential": _finite(self.Pt), "moment": _finite(self.M)},
-            "impulse_ratio": _finite(self.mu),
-            "critical_impulse_ratio": _finite(self.mu_c),
+            "impulse": {"normal": json_number(self.Pn), "tangential": json_number(self.Pt), "moment": json_number(self.M)},
+            "impulse_ratio": json_number(self.mu),
+            "critical_impulse_ratio": json_number(self.mu_c),
             "energy_loss": {
-                "total": _finite(self.TL),
-                "normal": _finite(self.TLn),
-                "tangential": _finite(self.TLt),
-                "moment": _finite(self.TLm),
+                "total": json_number(self.TL),
+                "normal": json_number(self.TLn),
+                "tangential": json_number(self.TLt),
+                "moment": json_number(self.TLm),
             },
             "flags": self.flags,
             "warnings": list(self.warnings),
@@ -132,9 +132,9 @@ class Result:
         width = max(14, len(one.name) + 2, len(two.name) + 2)
         lines = [f"{self.model} model, {self.units} units (impulses on vehicle 1, impact frame)", ""]
         lines.append(f"{'':<28}{one.name:>{width}}{two.name:>{width}}")
-        lines += [f"{label:<28}{_num(a):>{width}}{_num(b):>{width}}" for label, a, b in self._vehicle_rows()]
+        lines += [f"{label:<28}{table_cell(a):>{width}}{table_cell(b):>{width}}" for label, a, b in self._vehicle_rows()]
         lines.append("")
-        lines += [f"{label:<36}{_num(value):>14}" for label, value in self._impact_rows()]
+        lines += [f"{label:<36}{table_cell(value):>14}" for label, value in self._impact_rows()]
         lines.append("")
         if self.warnings:
             lines += ["warnings:"] + [f"  - {text}" for text in self.warnings]
@@ -214,11 +214,11 @@ def _vehicle_result(vehicle, out: Mapping[str, Any], number: int) -> VehicleResu
     )
 
 
-def _num(value: float) -> str:
+def table_cell(value: float) -> str:
     """A table cell: six significant digits, negative zero shown as 0."""
     return f"{value + 0.0:.6g}"
 
 
-def _finite(value: float) -> float | None:
+def json_number(value: float) -> float | None:
     """``value``, or ``None`` when it is NaN or infinite (JSON has no such numbers)."""
     return value if math.isfinite(value) else None
