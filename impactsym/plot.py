@@ -60,7 +60,7 @@ from .codes import FLAG_ENERGY_CREATED, FLAG_MU_BEYOND_CRITICAL, FLAG_TENSILE_IM
 from .result import UNIT_LABELS
 from .scene import Scene, SceneError, _read_file, load_scene
 
-__all__ = ["scene", "save_plot", "add_plot_argument", "INSTALL_HINT", "PRE_IMPACT_KINDS"]
+__all__ = ["scene", "save_plot", "add_plot_argument", "default_velocity_scale", "INSTALL_HINT", "PRE_IMPACT_KINDS"]
 
 INSTALL_HINT = "diagrams need matplotlib: pip install 'impactsym[plot]' (or pip install matplotlib)"
 
@@ -104,6 +104,7 @@ class _Body:
     w0: Optional[float] = None  # pre-impact yaw rate
     w1: Optional[float] = None  # post-impact yaw rate
     force: Optional[tuple[float, float]] = None  # direction of the impulse on the body (unit)
+    heading: Optional[float] = None  # the scene's ``heading`` [deg], for the PDOF label
 
 
 # --------------------------------------------------------------------------- public
@@ -154,7 +155,7 @@ def save_plot(scene_or_result: Any, path: Union[str, Path], *, scene: Optional[S
     if options:
         raise TypeError(f"save_plot: unexpected options {', '.join(sorted(options))}")
     path = Path(path)
-    fig.savefig(path, dpi=dpi)
+    fig.savefig(path, dpi=dpi, bbox_inches="tight")
     return path
 
 
@@ -169,6 +170,16 @@ def add_plot_argument(parser: argparse.ArgumentParser) -> None:
         "--plot", metavar="PATH", type=_plot_path, default=None,
         help="also draw the scene diagram to PATH (.png, .svg, .pdf; needs matplotlib)",
     )
+
+
+def default_velocity_scale(scene_or_result: Any, *, scene: Optional[SceneLike] = None,
+                           result: Any = None) -> float:
+    """The ``velocity_scale`` :func:`scene` would choose: the drawn length (scene
+    length unit) of one velocity unit, so that the longest arrow is about twice
+    the vehicles' size. Pass it back to keep arrows comparable between drawings."""
+    the_scene, the_result, position = _resolve(scene_or_result, scene, result)
+    size = _characteristic_length(the_scene)
+    return _auto_scale(_bodies(the_scene, the_result, position, size), size)
 
 
 # --------------------------------------------------------------------------- inputs
@@ -225,12 +236,10 @@ _SCENE_KINDS = {"solve": "forward", "invert": "inverse", "reconstruct": "reconst
 
 def _impact_position(source: SceneLike) -> tuple[float, float]:
     """``impact.position`` of the scene data when present, else the origin."""
-    impact = None
     if isinstance(source, Scene):
-        impact = source.impact
-        position = getattr(impact, "position", None)
+        position = getattr(source.impact, "position", None)
         if position is None:
-            position = getattr(impact, "extra", {}).get("position") if hasattr(impact, "extra") else None
+            position = (getattr(source.impact, "extra", None) or {}).get("position")
         if position is None:
             position = source.extra.get("impact_position")
         if position is None and source.source is not None:
@@ -358,7 +367,8 @@ def _bodies(scene: Scene, result: Any, centre, size: float) -> list[_Body]:
         else:
             offset = 0.5 * outline[0] if outline else _PARTICLE_OFFSET * size
             cg = _add(centre, _scale(n, offset if index else -offset))
-        bodies.append(_Body(vehicle.name, vehicle.fixed, cg, outline, v0, v1, dv, w0, w1))
+        bodies.append(_Body(vehicle.name, vehicle.fixed, cg, outline, v0, v1, dv, w0, w1,
+                            heading=_num(vehicle.extra.get("heading"))))
     _set_forces(bodies, result, n, t)
     return bodies
 
@@ -411,6 +421,14 @@ def _set_forces(bodies: list[_Body], result: Any, n, t) -> None:
             direction = body.dv
         if direction is not None and _norm(direction) > 0:
             body.force = _scale(direction, 1.0 / _norm(direction))
+
+
+def _auto_scale(bodies: list[_Body], size: float) -> float:
+    """Drawn length per velocity unit: the longest velocity or delta-V arrow is
+    ``_ARROW_LENGTH`` characteristic lengths."""
+    vectors = [v for body in bodies for v in (body.v0, body.v1, body.dv) if v is not None]
+    vmax = max((_norm(v) for v in vectors), default=0.0)
+    return _ARROW_LENGTH * size / vmax if vmax > 0 else 1.0
 
 
 # --------------------------------------------------------------------------- drawing
@@ -472,7 +490,7 @@ def _rotated(centre, heading_deg, local):
     return [(centre[0] + c * x - s * y, centre[1] + s * x + c * y) for x, y in local]
 
 
-def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, title: Optional[str]) -> None:
+def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, title: Optional[str]):
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
@@ -486,9 +504,7 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
     handles = []
 
     # velocity scale: drawn length per velocity unit
-    vectors = [v for body in bodies for v in (body.v0, body.v1, body.dv) if v is not None]
-    vmax = max((_norm(v) for v in vectors), default=0.0)
-    k = velocity_scale if velocity_scale else (_ARROW_LENGTH * size / vmax if vmax > 0 else 1.0)
+    k = velocity_scale if velocity_scale else _auto_scale(bodies, size)
     rates = [abs(w) for body in bodies for w in (body.w0, body.w1) if w is not None]
     wmax = max(rates, default=0.0)
 
@@ -514,9 +530,9 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
             canvas.polygon(_rotated(body.cg, heading, [(half_l, half_w), (-half_l, half_w),
                                                        (-half_l, -half_w), (half_l, -half_w)]),
                            facecolor=fill, edgecolor=edge, lw=1.5, alpha=0.9, zorder=1)
-            canvas.polygon(_rotated(body.cg, heading, [(0.92 * half_l, 0.0), (0.62 * half_l, 0.45 * half_w),
-                                                       (0.62 * half_l, -0.45 * half_w)]),
-                           facecolor=edge, edgecolor=edge, alpha=0.6, zorder=1)
+            canvas.polygon(_rotated(body.cg, heading, [(0.9 * half_l, 0.0), (0.75 * half_l, 0.25 * half_w),
+                                                       (0.75 * half_l, -0.25 * half_w)]),
+                           facecolor=edge, edgecolor=edge, alpha=0.5, zorder=1)
             reach = max(reach, half_l)
             handles.append(Patch(facecolor=fill, edgecolor=edge, label=f"{body.name} (outline, front ▶)"))
         else:
@@ -524,7 +540,7 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
             handles.append(Line2D([], [], ls="none", marker="o", ms=10, mfc=fill, mec=edge, label=body.name))
         canvas.marker(body.cg, ls="none", marker="o", ms=7, mfc="white", mec="black", mew=1.2, zorder=7)
         canvas.marker(body.cg, ls="none", marker="+", ms=7, mec="black", mew=1.2, zorder=8)
-        label_at = _add(body.cg, _scale(n, (1 if index else -1) * 0.28 * size))
+        label_at = _add(body.cg, _scale(t, -0.3 * size))
         canvas.text(label_at, body.name, ha="center", va="center", fontsize=9, color=edge, zorder=6,
                     bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.7))
 
@@ -555,17 +571,18 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
             canvas.text(middle, f"|ΔV| {_norm(body.dv):.3g}", fontsize=8, color=_COLOR["delta_v"],
                         ha="left", va="bottom", zorder=6)
             drawn.add("delta_v")
-        if body.force is not None:
+        if body.force is not None and not body.fixed:
             tail = _sub(body.cg, _scale(body.force, 0.75 * size))
             canvas.arrow(tail, body.cg, _COLOR["pdof"], lw=1.8, ls="-.", zorder=6, scale=12)
-            angle = math.degrees(math.atan2(body.force[1], body.force[0])) % 360.0
-            canvas.text(_sub(tail, _scale(body.force, 0.08 * size)), f"PDOF {angle:.0f}°", fontsize=8,
-                        color=_COLOR["pdof"], ha="center", va="center", zorder=6)
+            side = _scale((-body.force[1], body.force[0]), 0.12 * size)  # the two labels on opposite sides
+            canvas.text(_add(_sub(tail, _scale(body.force, 0.08 * size)), side),
+                        f"{body.name}: {_pdof_label(body)}", fontsize=8, color=_COLOR["pdof"],
+                        ha="center", va="center", zorder=6)
             drawn.add("pdof")
-        for rate, radius, ls, key in ((body.w0, 0.32, "--", "yaw_before"), (body.w1, 0.46, "-", "yaw_after")):
+        for rate, radius, ls, key in ((body.w0, 0.28, "--", "yaw_before"), (body.w1, 0.4, "-", "yaw_after")):
             if rate is None or wmax <= 0 or abs(rate) <= 1e-9 * wmax:
                 continue
-            sweep = math.copysign(40.0 + 230.0 * abs(rate) / wmax, rate)
+            sweep = math.copysign(40.0 + 180.0 * abs(rate) / wmax, rate)
             start = 100.0 if index == 0 else -80.0
             color = _COLOR["before"] if key == "yaw_before" else _COLOR["after"]
             end = canvas.arc(body.cg, radius * size, start, sweep, color, ls)
@@ -577,13 +594,13 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
         Line2D([], [], ls="none", marker="X", ms=9, mfc="black", mec="white", label="impact centre"),
         Line2D([], [], color=_COLOR["surface"], lw=2.5, label="crush surface (along t)"),
         Line2D([], [], color=_COLOR["normal"], lw=1.5, marker=">", ms=5,
-               label=f"normal n (Γ = {scene.impact.normal_angle:g}°)"),
+               label="normal n (vehicle 1 → 2)"),
     ]
     legend_lines = {
         "before": (dict(color=_COLOR["before"], lw=2.2), f"velocity before [{speed_unit}]"),
         "after": (dict(color=_COLOR["after"], lw=2.2), f"velocity after [{speed_unit}]"),
         "delta_v": (dict(color=_COLOR["delta_v"], lw=2.0, ls="--"), f"delta-V [{speed_unit}]"),
-        "pdof": (dict(color=_COLOR["pdof"], lw=1.8, ls="-."), "PDOF (impulse on vehicle) [°]"),
+        "pdof": (dict(color=_COLOR["pdof"], lw=1.8, ls="-."), "PDOF: impulse on vehicle [°]"),
         "yaw_before": (dict(color=_COLOR["before"], lw=1.6, ls="--"), "yaw rate before [rad/s] (ccw +)"),
         "yaw_after": (dict(color=_COLOR["after"], lw=1.6), "yaw rate after [rad/s] (ccw +)"),
     }
@@ -606,10 +623,37 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
             ax.text(0.01, 0.01, "flagged: " + "; ".join(problems), transform=ax.transAxes, fontsize=9,
                     color="crimson", ha="left", va="bottom", zorder=10,
                     bbox=dict(boxstyle="round,pad=0.25", fc="white", ec="crimson", alpha=0.85))
+    legend_title = f"arrows: 1 {length_unit} = {1.0 / k:.3g} {speed_unit}"
     if legend:
-        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8,
-                  title=f"arrows: 1 {length_unit} = {1.0 / k:.3g} {speed_unit}", title_fontsize=8,
-                  frameon=False)
+        _legend(ax, handles, legend_title)
+    return handles, legend_title
+
+
+def _legend(ax, handles, title: str):
+    """The legend, outside the axes on the right."""
+    return ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8,
+                     title=title, title_fontsize=8, frameon=False)
+
+
+def _render(ax, scene_or_result: Any, *, scene: Optional[SceneLike] = None,
+            velocity_scale: Optional[float] = None, title: Optional[str] = None):
+    """Draw like :func:`scene` but without the legend; return ``(handles, legend title)``
+    for :func:`_legend` (the explorer adds the legend only when it changes)."""
+    the_scene, the_result, position = _resolve(scene_or_result, scene, None)
+    return _draw(ax, the_scene, the_result, position, velocity_scale, False, title)
+
+
+def _pdof_label(body: _Body) -> str:
+    """The PDOF as text. With the vehicle's ``heading``: the CRASH3 habit of
+    :mod:`impactsym.reconstruct` (where the impulse comes from, degrees
+    clockwise from straight ahead, and the clock position); without it: the
+    direction of the impulse in the scene frame (counter-clockwise from +x)."""
+    angle = math.degrees(math.atan2(body.force[1], body.force[0]))
+    if body.heading is None:
+        return f"PDOF → {round(angle) % 360}°"
+    clockwise = (body.heading - angle - 180.0 + 180.0) % 360.0 - 180.0
+    clock = (round(clockwise / 30.0) - 1) % 12 + 1
+    return f"PDOF {clockwise:.0f}° ({clock} o'clock)"
 
 
 def _title(scene: Scene, result: Any) -> str:
@@ -618,9 +662,10 @@ def _title(scene: Scene, result: Any) -> str:
     mu = ("μ = μ_c" if impact.critical else f"slip = {impact.slip:g}"
           if impact.impulse_ratio is None else f"μ = {float(impact.impulse_ratio):g}")
     em = f", e_m = {impact.moment_restitution:g}" if scene.uses_yaw else ""
-    head = f"{name}: {scene.model} model, {scene.units}; e = {impact.restitution:g}, {mu}{em}"
+    head = (f"{name}: {scene.model} model, {scene.units}; Γ = {impact.normal_angle:g}°, "
+            f"e = {impact.restitution:g}, {mu}{em}")
     if getattr(result, "kind", None) == "reconstruct":
-        head = (f"{name}: reconstruction, {scene.units}; implied e = {result.e:.3g}, "
+        head = (f"{name}: reconstruction, {scene.units}; Γ = {impact.normal_angle:g}°, implied e = {result.e:.3g}, "
                 f"e_m = {result.e_m:.3g}")
     if result is None:
         return head
