@@ -24,7 +24,7 @@ import sympy as sp
 
 from . import frame as f
 from . import planar
-from .frame import I1, I2, e, gamma, j1, j2, k1, k2, m1, m2, mu, nx, ny, r1x, r1y, r2x, r2y
+from .frame import I1, I2, e, gamma, j1, j2, k1, k2, m1, m2, mu, r1x, r1y, r2x, r2y
 from .kernel import Block, Guard, Kernel, finite_inputs, positive_or_fixed, real
 from .planar import Cnn, Cnt, Ctt, D, r1n, r1t, r2n, r2t
 

@@ -26,10 +26,7 @@ from .frame import (
     r1x, r1y, r2x, r2y, v1x, v1y, v2x, v2y, w1, w2, wr,
 )
 from .kernel import Block, Guard, Kernel, finite_inputs, positive_or_fixed, real
-from .planar import (
-    Cnm, Ctm, Knn, Knt, Ktt, am, c1, c2, drn, drt, drx, dry, hn, ht, jbar, kk,
-    r1n, r1t, r2n, r2t, wa, wb, wc,
-)
+from .planar import Cnm, Ctm, c1, c2, drx, dry, kk, r1n, r1t, r2n, r2t
 
 # Below this, e or |e_m| leaves the answer dominated by the error of the finals
 # (it is amplified by 1/e): refused, not divided by.
@@ -60,12 +57,10 @@ def _separating_guard() -> Guard:
 def _rigid_blocks():
     r1n_, r1t_ = f.to_impact_frame(r1x, r1y)
     r2n_, r2t_ = f.to_impact_frame(r2x, r2y)
-    drn_, drt_ = f.to_impact_frame(drx, dry)
     G = planar.relative_velocity()
     final_rel = tuple(c.xreplace({f.dvx: dVx, f.dvy: dVy, w1: W1, w2: W2}) for c in G)
     Gn_, Gt_ = f.to_impact_frame(Gx, Gy)
     C = planar.compliance()
-    keff = planar.effective_compliance()
     px, py = f.to_scene_frame(Pn, Pt)
     # Restitution gives the initial normal approach; the initial relative
     # motion is the final one plus C·(Pn, Pt, M).
@@ -77,13 +72,11 @@ def _rigid_blocks():
               Guard((sp.StrictGreaterThan(k1 + k2, 0), sp.StrictGreaterThan(j1 + j2, 0)),
                     "SINGULAR")),
         Block(((r1n, r1n_), (r1t, r1t_), (r2n, r2n_), (r2t, r2t_), (Gx, final_rel[0]),
-               (Gy, final_rel[1]), (drn, drn_), (drt, drt_), (kk, k1 + k2),
-               (jbar, j1 * j2 / (j1 + j2)), (Jsum, j1 + j2))),
+               (Gy, final_rel[1]), (Jsum, C[2, 2]))),
+    ) + planar.compliance_pieces() + (
         Block(((Gn, Gn_), (Gt, Gt_), (Cnn, C[0, 0]), (Cnt, C[0, 1]), (Ctt, C[1, 1]),
-               (Cnm, C[0, 2]), (Ctm, C[1, 2]),
                # Moment restitution solved for M: e_m in the denominator.
-               (M, (1 - e_m) * Wr / (e_m * Jsum)),
-               (am, (1 - e_m) / Jsum), (wa, e_m * j1), (wb, e_m * j2), (wc, (1 - e_m) * jbar)),
+               (M, (1 - e_m) * Wr / (e_m * Jsum))),
               _separating_guard()),
         Block(((Dn, Cnn + mu * Cnt), (dgn_inv, (1 + e) * Gn / e)),
               Guard((sp.Ne(Dn, 0),), "SINGULAR")),
@@ -96,14 +89,10 @@ def _rigid_blocks():
                (v2y, V2y + k2 * Py), (w1, W1 - j1 * (c1 + M)), (w2, W2 + j2 * (c2 + M)),
                # (gn + Gn) = Gn (e - 1)/e: one factor, as in the forward kernels.
                (TLn, Pn * sp.factor(gn_ + Gn) / 2), (TLt, Pt * (gt + Gt) / 2),
-               (TLm, M * (wr + Wr) / 2))
-              + tuple(keff.items())),
+               (TLm, M * (wr + Wr) / 2))),
+        Block(((TL, TLn + TLt + TLm),)),
         # μ_c of the recovered scene: the forward kernel's sticking ratio.
-        Block(((planar.bn, (1 + e) * gn - hn), (planar.bt, gt - ht), (TL, TLn + TLt + TLm))),
-        Block(((planar.Dc, Ktt * planar.bn - Knt * planar.bt),),
-              Guard((sp.Ne(planar.Dc, 0),), "SINGULAR")),
-        Block(((mu_c, (Knn * planar.bt - Knt * planar.bn) / planar.Dc),)),
-    )
+    ) + planar.critical_ratio_blocks()
 
 
 def _particle_blocks():
