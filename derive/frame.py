@@ -28,6 +28,7 @@ V1x, V1y, W1, V2x, V2y, W2 = real("V1x V1y W1 V2x V2y W2")
 Pn, Pt, M, Px, Py = real("Pn Pt M Px Py")
 mu_c, TL, TLn, TLt, TLm = real("mu_c TL TLn TLt TLm")
 mu_used = sp.Symbol("mu_used", real=True)
+dV1, dV2 = real("dV1 dV2")
 tol_energy, tol_mu = real("tol_energy tol_mu")
 
 # Relative motion at the impact centre: g = u2 - u1 (u: contact-point velocity),
@@ -47,6 +48,22 @@ def inverse_masses(masses, inverses):
 def normal_components():
     """Assignments nx = cos Γ, ny = sin Γ."""
     return ((nx, sp.cos(gamma)), (ny, sp.sin(gamma)))
+
+
+def delta_v_magnitudes():
+    """Assignments dV_i = |V_i - v_i| = |P|/m_i from the impulse components: no
+    difference of final and initial velocities, exactly 0 for a fixed body."""
+    impulse = sp.sqrt(Pn**2 + Pt**2)
+    return ((dV1, k1 * impulse), (dV2, k2 * impulse))
+
+
+def delta_v_magnitudes_hold(expand) -> bool:
+    """Proof helper: dV_i² = |V_i - v_i|² for the expressions `expand(sym)` gives
+    (a kernel's formulas with Pn, Pt kept free), modulo nx² + ny² = 1."""
+    pairs = ((dV1, V1x, V1y, v1x, v1y), (dV2, V2x, V2y, v2x, v2y))
+    return all(
+        reduce_unit_normal(expand(dv)**2 - (expand(vx) - ix)**2 - (expand(vy) - iy)**2) == 0
+        for dv, vx, vy, ix, iy in pairs)
 
 
 def to_impact_frame(ax, ay):

@@ -16,14 +16,14 @@ import sympy as sp
 
 from . import frame as f
 from .frame import (
-    Pn, Pt, Px, Py, TL, TLn, TLt, V1x, V1y, V2x, V2y,
+    Pn, Pt, Px, Py, TL, TLn, TLt, V1x, V1y, V2x, V2y, dV1, dV2,
     dgn, dgt, dvx, dvy, e, gamma, gn, gt, k1, k2, m1, m2, mu, mu_c, mu_used,
     nx, ny, v1x, v1y, v2x, v2y,
 )
 from .kernel import Block, Guard, Kernel, finite_inputs, positive_or_fixed, real
 
 INPUTS = (m1, m2, v1x, v1y, v2x, v2y, gamma, e, mu)
-OUTPUTS = (V1x, V1y, V2x, V2y, Pn, Pt, mu_used, mu_c, TL, TLn, TLt)
+OUTPUTS = (V1x, V1y, V2x, V2y, Pn, Pt, mu_used, mu_c, dV1, dV2, TL, TLn, TLt)
 
 mbar = sp.Symbol("mbar", positive=True)  # the seed's m̄ = m1·m2/(m1 + m2)
 
@@ -104,6 +104,7 @@ def _kernel_blocks(sticking: bool):
             (
                 (Px, px),
                 (Py, py),
+                *f.delta_v_magnitudes(),
                 # Work of each impulse component on the mean relative velocity
                 # (eqs 21–26). (gn + Gn) factors to (1 - e)·gn: never a sum of
                 # nearly opposite velocities when e is close to 1.
@@ -182,6 +183,8 @@ def proofs():
             finals[sn], finals[st] = f.to_impact_frame(got[sx], got[sy])
         out.append((f"{tag}: kernel final velocities equal the printed solution",
                     all(_zero(finals[s] - printed[s].xreplace(seed_vals)) for s in printed)))
+        out.append((f"{tag}: dV1, dV2 are |V1 - v1|, |V2 - v2|",
+                    f.delta_v_magnitudes_hold(lambda x: knl.expanded(x, keep | {Pn, Pt}))))
         out.append((f"{tag}: P equals m1 (V1 - v1) (eqs 4, 6)",
                     _zero(got[Pn] - (finals[V1n] - seed_vals[v1n]) / k1)
                     and _zero(got[Pt] - (finals[V1t] - seed_vals[v1t]) / k1)))

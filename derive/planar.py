@@ -21,14 +21,14 @@ import sympy as sp
 from . import frame as f
 from . import particle
 from .frame import (
-    I1, I2, M, Pn, Pt, Px, Py, TL, TLm, TLn, TLt, V1x, V1y, V2x, V2y, W1, W2,
+    I1, I2, M, Pn, Pt, Px, Py, TL, TLm, TLn, TLt, V1x, V1y, V2x, V2y, W1, W2, dV1, dV2,
     dgn, dvx, dvy, e, e_m, gamma, gn, gt, gx, gy, j1, j2, k1, k2, m1, m2, mu, mu_c,
     mu_used, nx, ny, r1x, r1y, r2x, r2y, v1x, v1y, v2x, v2y, w1, w2, wr,
 )
 from .kernel import Block, Guard, IsFinite, Kernel, finite_inputs, positive_or_fixed, real
 
 INPUTS = (m1, m2, I1, I2, v1x, v1y, w1, v2x, v2y, w2, r1x, r1y, r2x, r2y, gamma, e, mu, e_m)
-OUTPUTS = (V1x, V1y, W1, V2x, V2y, W2, Pn, Pt, M, mu_used, mu_c, TL, TLn, TLt, TLm)
+OUTPUTS = (V1x, V1y, W1, V2x, V2y, W2, Pn, Pt, M, mu_used, mu_c, dV1, dV2, TL, TLn, TLt, TLm)
 
 r1n, r1t, r2n, r2t = real("r1n r1t r2n r2t")
 Cnn, Cnt, Ctt, Cnm, Ctm, Cmm = real("Cnn Cnt Ctt Cnm Ctm Cmm")
@@ -216,6 +216,7 @@ def _final_blocks(sticking: bool):
         Block(
             (
                 (Px, px), (Py, py), (c1, levers[0]), (c2, levers[1]), (cd, levers[2]),
+                *f.delta_v_magnitudes(),
                 (mu_used, mu_c if sticking else mu),
                 # (gn + Gn) with Gn = -e·gn factors to (1 - e)·gn (see particle).
                 (TLn, Pn * sp.factor(gn - e * gn) / 2),
@@ -402,6 +403,8 @@ def _kernel_checks(knl: Kernel, sticking: bool, sliding: Kernel | None = None):
     tag = knl.name
     out = [(f"{tag}: the closed forms satisfy the six equations",
             _six_equations_hold(knl, sticking))]
+    out.append((f"{tag}: dV1, dV2 are |V1 - v1|, |V2 - v2|",
+                f.delta_v_magnitudes_hold(lambda x: _expanded(knl, x, frozenset({Pn, Pt})))))
     g0 = tuple(c.xreplace({dvx: v2x - v1x, dvy: v2y - v1y}) for c in relative_velocity())
     gn0, gt0 = f.to_impact_frame(*g0)
     wr0 = w2 - w1

@@ -148,6 +148,7 @@ def _final_blocks():
     lever1, lever2 = (x.xreplace(NO_MOMENT) for x in planar.lever_products_sticking()[:2])
     return (
         Block(((Px, px), (Py, py), (c1, lever1), (c2, lever2), (M, sp.Integer(0)),
+               *f.delta_v_magnitudes(),
                (TLn, Pn * gn / 2), (TLt, Pt * (1 + slip) * gt / 2))),
         Block(((V1x, v1x + k1 * Px), (V1y, v1y + k1 * Py), (V2x, v2x - k2 * Px),
                (V2y, v2y - k2 * Py), (W1, w1 + j1 * c1), (W2, w2 - j2 * c2),
@@ -286,6 +287,8 @@ def _sideswipe_claims():
     out = [(f"{tag}: momentum, angular impulse and M = 0 hold; Gn = 0 and Gt = slip*gt",
             _zero(free[M]) and all(_zero(r) for r in residuals) and _compliance_lemma(knl, {}, G)
             and constraints and det and _zero(back[0] - Pn) and _zero(back[1] - Pt))]
+    out.append((f"{tag}: dV1, dV2 are |V1 - v1|, |V2 - v2|",
+                f.delta_v_magnitudes_hold(lambda x: knl.expanded(x, KEEP | {Pn, Pt}))))
     # Energy: for any (Pn, Pt) the kinetic energy lost is the work on the mean
     # relative velocity; with Gn = 0 and Gt = slip*gt that is TLn + TLt.
     gn0, gt0 = (knl.expanded(s, KEEP) for s in (gn, gt))

@@ -30,7 +30,7 @@ from generated.presets import COEFFICIENT_INPUTS, PRESETS  # noqa: E402
 SERIAL_BELOW = 64
 
 OUTPUTS = ("V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M",
-           "mu", "mu_c", "TL", "TLn", "TLt", "TLm")
+           "mu", "mu_c", "dV1", "dV2", "TL", "TLn", "TLt", "TLm")
 
 
 @dataclass(frozen=True)
@@ -70,6 +70,33 @@ INVERSE = {
     "particle": _kernel_set(inverse, "particle_inverse"),
 }
 RECONSTRUCT = _kernel_set(reconstruct, "reconstruct")
+
+# Output tiers of solve_batch(outputs=...): each adds to the one before.
+TIERS = {
+    "velocities": OUTPUTS[:6],
+    "impulses": OUTPUTS[:13],
+    "energy": OUTPUTS,
+}
+
+
+def requested_outputs(outputs) -> tuple[tuple[str, ...], str]:
+    """(names to return, smallest tier that has them) for solve_batch's
+    `outputs`: None or "all" (every output), a tier name, or a list of names."""
+    if outputs is None or outputs == "all":
+        return OUTPUTS, "energy"
+    if isinstance(outputs, str):
+        if outputs not in TIERS:
+            raise ValueError(f"outputs: unknown tier {outputs!r} (use one of "
+                             f"{', '.join(TIERS)}, all, or a list of output names)")
+        return TIERS[outputs], outputs
+    names = tuple(outputs)
+    unknown = [name for name in names if name not in OUTPUTS]
+    if unknown or not names:
+        raise ValueError(f"outputs: unknown output {', '.join(unknown) or '(none given)'} "
+                         f"(outputs are {' '.join(OUTPUTS)})")
+    tier = next(t for t, have in TIERS.items() if set(names) <= set(have))
+    return names, tier
+
 
 INVERSE_OUTPUTS = ("v1x", "v1y", "w1", "v2x", "v2y", "w2", "Pn", "Pt", "M",
                    "mu_c", "TL", "TLn", "TLt", "TLm")

@@ -10,7 +10,6 @@ from __future__ import annotations
 import numpy as np
 
 from . import _kernels
-from ._kernels import OUTPUTS
 
 
 def _is_dataframe(obj) -> bool:
@@ -64,7 +63,7 @@ def run_columns(ks: _kernels.KernelSet, columns, outputs, placeholders=()):
     return result
 
 
-def solve_batch(columns, model: str = "rigid"):
+def solve_batch(columns, model: str = "rigid", outputs=None, engine: str = "local"):
     """Solve one scene per row with the generated kernels.
 
     `columns` maps input names to equal-length float64 arrays (a dict or a
@@ -81,15 +80,30 @@ def solve_batch(columns, model: str = "rigid"):
     e_m = 1); ``"impac_sideswipe"`` takes a ``slip`` column in place of ``e mu
     e_m``; ``"brach"`` is ``"rigid"``.
 
-    Returns the same kind of mapping with ``V1x V1y W1 V2x V2y W2 Pn Pt M mu
-    mu_c TL TLn TLt TLm`` (float64) and ``status`` and ``flags`` (int32): see
-    `impactsym.codes` for their meanings.
+    `outputs` selects what is computed and returned: ``"velocities"`` (``V1x
+    V1y W1 V2x V2y W2``), ``"impulses"`` (those plus ``Pn Pt M mu mu_c dV1
+    dV2``; ``dV1``, ``dV2`` are the delta-V magnitudes), ``"energy"`` or
+    ``"all"`` or None (those plus ``TL TLn TLt TLm``), or a list of those
+    names. ``status`` and ``flags`` are always returned, and the physics flags
+    are always computed, whatever the tier. ``engine="dask"`` runs the same
+    kernels over chunks on the active ``dask.distributed`` client (the
+    ``dask`` extra); the result is identical.
+
+    Returns the same kind of mapping with the requested outputs (float64) and
+    ``status`` and ``flags`` (int32): see `impactsym.codes` for their meanings.
     """
+    names, _tier = _kernels.requested_outputs(outputs)
+    if engine == "dask":
+        from .dask_engine import solve_batch_dask
+
+        return solve_batch_dask(columns, model=model, outputs=outputs)
+    if engine != "local":
+        raise ValueError(f"engine: unknown engine {engine!r} (use local or dask)")
     family, fixed = _kernels.preset(model)
     merged = _with_fixed(columns, fixed, model) if fixed else columns
     critical = _critical_mode(merged)
     ks = _kernels.kernel_for(family, critical)
-    result = run_columns(ks, merged, OUTPUTS, ("mu",) if critical else ())
+    result = run_columns(ks, merged, names, ("mu",) if critical else ())
     if merged is not columns and _is_dataframe(columns):
         import pandas as pd
 
