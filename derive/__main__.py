@@ -36,7 +36,8 @@ def render_all() -> dict[str, str]:
     for name in MODEL_MODULES:
         mod = importlib.import_module(f"derive.{name}")
         doc = (mod.__doc__ or "").strip().splitlines()[0]
-        files[f"{name}.py"] = emit.render_module(f"{name}.py", doc, mod.KERNELS, digest,
+        kernels = getattr(mod, "EMITTED", mod.KERNELS)
+        files[f"{name}.py"] = emit.render_module(f"{name}.py", doc, kernels, digest,
                                                  data=getattr(mod, "DATA", ()))
     files["codes.py"] = emit.render_codes(digest)
     files["__init__.py"] = emit.render_init(MODEL_MODULES, digest)

@@ -2,7 +2,7 @@
 
 For each kernel it writes a per-scene function (`@njit`, plain-Python twin via
 `.py_func`), a `prange` batch driver and a serial twin over struct-of-arrays
-inputs with caller-owned outputs, all in the same file (numba's cache does not
+inputs (each an array or a scalar) with caller-owned outputs, all in the same file (numba's cache does not
 track callees in other files). Common subexpressions are eliminated block by
 block; output is deterministic (SymPy's canonical ordering, a fixed temporary
 naming, no timestamps). Arithmetic is strict IEEE: no fastmath.
@@ -179,7 +179,7 @@ def scene_function(kernel: Kernel, style: Style = DEFAULT) -> str:
     for name, conditions in kernel.flags:
         cond = " or ".join(f"({style.code(c)})" for c in conditions)
         lines += [f"{ind}if {cond}:", f"{ind}    flags |= {FLAGS[name]}  # {name}"]
-    total = " + ".join(str(s) for s in kernel.outputs)
+    total = " + ".join(str(s) for s in kernel.finite_checked())
     lines += [f"{ind}if not math.isfinite({total}):",
               f"{ind}    return _{kernel.name}_failed({STATUS['OVERFLOW']})  # OVERFLOW",
               f"{ind}return ({outs}, 0, flags)"]
@@ -193,38 +193,106 @@ def failed_function(kernel: Kernel, style: Style = DEFAULT) -> str:
             f"    return ({nans}, status, 0)\n")
 
 
-def batch_function(kernel: Kernel, parallel: bool, style: Style = DEFAULT) -> str:
-    """The batch driver over struct-of-arrays inputs into caller-owned outputs."""
-    name = f"{kernel.name}_batch" + ("" if parallel else "_serial")
-    ins = [str(s) for s in kernel.inputs]
+def column_names(kernel: Kernel) -> tuple[str, ...]:
+    """The kernel's batch columns: its inputs, with the angle in place of the
+    normal components for a kernel in normal form."""
+    names = [str(s) for s in kernel.inputs]
+    if kernel.angle is not None:
+        at = names.index("nx")
+        names[at:at + 2] = [str(kernel.angle)]
+    return tuple(names)
+
+
+def batch_function(kernel: Kernel, parallel: bool, style: Style = DEFAULT,
+                   normal: bool = False) -> str:
+    """A batch driver into caller-owned outputs. Every input may be an array
+    (one value per row) or a scalar (the same for every row): `_at` picks.
+    A kernel in normal form gets drivers that take the angle (cos/sin per row)
+    and, with `normal`, drivers that take (nx, ny) as given."""
+    name = f"{kernel.name}_batch" + ("_normal" if normal else "") + ("" if parallel else "_serial")
+    args = [str(s) for s in kernel.inputs]
+    ins = args if normal or kernel.angle is None else list(column_names(kernel))
     outs = [f"out_{s}" for s in kernel.output_names()] + ["out_status", "out_flags"]
     loop = "prange" if parallel else "range"
     results = ", ".join(f"_r{i}" for i in range(len(outs)))
+    calls = [f"_at({a}, i)" for a in args]
+    body = []
+    if kernel.angle is not None and not normal:
+        at = args.index("nx")
+        body = [f"        _angle = _at({kernel.angle}, i)"]
+        calls[at:at + 2] = ["math.cos(_angle)", "math.sin(_angle)"]
     lines = [f"@{style.jit(parallel)}",
              f"def {name}({', '.join(ins + outs)}):",
              f'    """{"Parallel" if parallel else "Serial"} batch of `{kernel.name}`: '
              'one row per index, outputs written in place."""',
-             f"    for i in {loop}({ins[0]}.shape[0]):",
-             f"        {results} = {kernel.name}({', '.join(f'{a}[i]' for a in ins)})"]
+             f"    for i in {loop}(out_status.shape[0]):", *body,
+             f"        {results} = {kernel.name}({', '.join(calls)})"]
     lines += [f"        {o}[i] = _r{i}" for i, o in enumerate(outs)]
     return "\n".join(lines) + "\n"
+
+
+# A driver input is an array (one value per row) or a scalar (one value for
+# all rows); `_at` is resolved by type at compile time and inlined.
+SCALAR_OR_ARRAY = '''def _at(x, i):
+    """x[i] for an array, x itself for a scalar (resolved at compile time)."""
+
+
+@overload(_at, inline="always")
+def _at_overload(x, i):
+    if isinstance(x, types.Array):
+        return lambda x, i: x[i]
+    return lambda x, i: x
+'''
+
+
+def unit_normal_function(style: Style = DEFAULT) -> str:
+    """`unit_normal(gamma)` → (nx, ny) for the kernels in normal form; NaN for
+    a non-finite angle (which the kernels then reject as a non-finite input)."""
+    from .frame import gamma, normal_components
+
+    (_, cos), (_, sin) = normal_components()
+    return (f"@{style.jit()}\ndef unit_normal(gamma):\n"
+            '    """The contact normal (nx, ny) of the angle gamma [rad]."""\n'
+            f"    if not math.isfinite({gamma}):\n        return (math.nan, math.nan)\n"
+            f"    return ({style.code(cos)}, {style.code(sin)})\n")
+
+
+def _drivers(knl: Kernel, style: Style) -> list[str]:
+    """The batch drivers of one kernel."""
+    forms = (False, True) if knl.angle is not None else (False,)
+    return [text for normal in forms for parallel in (True, False)
+            for text in ("", batch_function(knl, parallel, style, normal))]
 
 
 def render_module(model_file: str, doc: str, kernels, digest: str,
                   style: Style = DEFAULT, data=()) -> str:
     """A whole generated module as text. `data` holds (NAME, value) pairs of
     plain Python literals (numbers, strings, tuples, dicts) written as module
-    constants before the kernels: tables a model module derives, not formulas."""
+    constants before the kernels: tables a model module derives, not formulas.
+
+    Per kernel: NAME_INPUTS (batch columns), NAME_OUTPUTS (computed outputs),
+    NAME_CONSTANTS (outputs fixed to a number), and for a kernel in normal form
+    NAME_ARGUMENTS (the per-scene function's arguments, nx and ny in place of
+    the angle)."""
     parts = [header(model_file, digest), f'"""{doc}"""', "",
-             *style.imports, "", "from numba import njit, prange", ""]
+             *style.imports, "", "from numba import njit, prange, types",
+             "from numba.extending import overload", ""]
     for name, value in data:
         parts += [f"{name} = {pprint.pformat(value, width=100, sort_dicts=False)}", ""]
     for knl in kernels:
-        parts += [f"{knl.name.upper()}_INPUTS = {tuple(str(s) for s in knl.inputs)!r}",
-                  f"{knl.name.upper()}_OUTPUTS = {knl.output_names()!r}", ""]
+        upper = knl.name.upper()
+        parts += [f"{upper}_INPUTS = {column_names(knl)!r}",
+                  f"{upper}_OUTPUTS = {knl.output_names()!r}",
+                  f"{upper}_CONSTANTS = {dict(knl.constants)!r}"]
+        if knl.angle is not None:
+            parts.append(f"{upper}_ARGUMENTS = {tuple(str(s) for s in knl.inputs)!r}")
+        parts.append("")
+    parts += ["", SCALAR_OR_ARRAY]
+    if any(knl.angle is not None for knl in kernels):
+        parts += ["", unit_normal_function(style)]
     for knl in kernels:
-        parts += ["", failed_function(knl, style), "", scene_function(knl, style), "",
-                  batch_function(knl, True, style), "", batch_function(knl, False, style)]
+        parts += ["", failed_function(knl, style), "", scene_function(knl, style),
+                  *_drivers(knl, style)]
     return "\n".join(parts).rstrip("\n") + "\n"
 
 

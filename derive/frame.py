@@ -29,7 +29,9 @@ Pn, Pt, M, Px, Py = real("Pn Pt M Px Py")
 mu_c, TL, TLn, TLt, TLm = real("mu_c TL TLn TLt TLm")
 mu_used = sp.Symbol("mu_used", real=True)
 dV1, dV2 = real("dV1 dV2")
-tol_energy, tol_mu = real("tol_energy tol_mu")
+# Flag tolerances are sums of absolute values: non-negative, so a part that is
+# identically 0 (TLm with e_m = 1) gives a flag condition SymPy decides False.
+tol_energy, tol_mu = sp.symbols("tol_energy tol_mu", nonnegative=True)
 
 # Relative motion at the impact centre: g = u2 - u1 (u: contact-point velocity),
 # gn = n·g (< 0 when approaching), gt = t·g, wr = w2 - w1.

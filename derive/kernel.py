@@ -48,7 +48,10 @@ class Kernel:
     `checks` the input guards evaluated before any arithmetic, `blocks` the
     formulas, `outputs` the returned symbols in order (then `status`, `flags`),
     and `flags` pairs of (flag name, conditions any of which raises it) on a
-    solved row.
+    solved row. Specialised kernels (derive/specialise.py) also carry
+    `constants` (outputs that are a fixed number, published by name rather
+    than computed), `finite` (see `finite_checked`) and `angle` (the angle
+    input that the normal components (nx, ny) among `inputs` stand for).
     """
 
     name: str
@@ -58,10 +61,24 @@ class Kernel:
     blocks: tuple[Block, ...]
     outputs: tuple[sp.Symbol, ...]
     flags: tuple[tuple[str, tuple], ...] = field(default_factory=tuple)
+    constants: tuple[tuple[str, float], ...] = ()
+    finite: tuple[sp.Symbol, ...] | None = None
+    angle: sp.Symbol | None = None
+
+    @staticmethod
+    def public_name(sym: sp.Symbol) -> str:
+        """The batch column name of an output symbol: `mu_used` is `mu`."""
+        return "mu" if sym.name == "mu_used" else sym.name
 
     def output_names(self) -> tuple[str, ...]:
-        """Public output names (batch columns): `mu_used` is published as `mu`."""
-        return tuple("mu" if s.name == "mu_used" else s.name for s in self.outputs)
+        """Public output names (batch columns) of the computed outputs."""
+        return tuple(self.public_name(s) for s in self.outputs)
+
+    def finite_checked(self) -> tuple[sp.Symbol, ...]:
+        """The quantities whose overflow makes a row fail (status OVERFLOW):
+        the outputs, or for a specialised kernel its base kernel's outputs that
+        it still computes, so that the row status does not depend on the tier."""
+        return self.outputs if self.finite is None else self.finite
 
     def definitions(self) -> dict[sp.Symbol, sp.Expr]:
         """Every assigned symbol with its formula, in evaluation order."""

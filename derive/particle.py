@@ -15,6 +15,7 @@ from __future__ import annotations
 import sympy as sp
 
 from . import frame as f
+from . import specialise
 from .frame import (
     Pn, Pt, Px, Py, TL, TLn, TLt, V1x, V1y, V2x, V2y, dV1, dV2,
     dgn, dgt, dvx, dvy, e, gamma, gn, gt, k1, k2, m1, m2, mu, mu_c, mu_used,
@@ -148,6 +149,9 @@ def kernel(sticking: bool) -> Kernel:
 
 
 KERNELS = (kernel(sticking=False), kernel(sticking=True))
+
+# What generated/particle.py holds: each kernel in normal form, for every output tier.
+EMITTED = tuple(k for base in KERNELS for k in specialise.tiers(specialise.normal_form(base)))
 
 
 # ---------------------------------------------------------------- proofs

@@ -19,7 +19,7 @@ from __future__ import annotations
 import sympy as sp
 
 from . import frame as f
-from . import particle
+from . import particle, specialise
 from .frame import (
     I1, I2, M, Pn, Pt, Px, Py, TL, TLm, TLn, TLt, V1x, V1y, V2x, V2y, W1, W2, dV1, dV2,
     dgn, dvx, dvy, e, e_m, gamma, gn, gt, gx, gy, j1, j2, k1, k2, m1, m2, mu, mu_c,
@@ -271,6 +271,21 @@ def kernel(sticking: bool) -> Kernel:
 KERNELS = (kernel(sticking=False), kernel(sticking=True))
 
 
+def emitted_kernels() -> tuple[Kernel, ...]:
+    """What generated/planar.py holds: each kernel in normal form, for every
+    output tier, general and with e_m = 1 (no moment impulse)."""
+    out = []
+    for base in KERNELS:
+        general = specialise.normal_form(base)
+        no_moment = specialise.fix_inputs(general, f"{base.name}_em1", {e_m: 1},
+                                          "Moment restitution e_m = 1: no moment impulse.")
+        out += specialise.tiers(general) + specialise.tiers(no_moment)
+    return tuple(out)
+
+
+EMITTED = emitted_kernels()
+
+
 def ke_difference_kernel() -> Kernel:
     """The sliding kernel with TL as the naive kinetic-energy difference
     T_before - T_after (finite masses only). Not emitted to generated/: it
@@ -505,10 +520,37 @@ def _reduces_to_particle(got) -> bool:
     return True
 
 
+def _specialised_checks():
+    """The emitted kernels with e_m = 1 have M ≡ 0 and TLm ≡ 0 and otherwise
+    the general kernel's outputs at e_m = 1 (expanded to the inverse masses
+    and the normal); every tier's outputs are the full kernel's."""
+    out = []
+    by_name = {k.name: k for k in EMITTED}
+    for base in KERNELS:
+        general = by_name[base.name]
+        no_moment = by_name[f"{base.name}_em1"]
+        same = all(_zero(no_moment.expanded(o, KEEP)
+                         - general.expanded(o, KEEP).xreplace({e_m: 1}))
+                   for o in no_moment.outputs)
+        out.append((f"{no_moment.name}: M = TLm = 0 and the other outputs are "
+                    f"{base.name}'s at e_m = 1",
+                    dict(no_moment.constants) == {"M": 0.0, "TLm": 0.0} and same))
+        for full in (general, no_moment):
+            out.append((f"{full.name}: every output tier computes the full kernel's formulas",
+                        all(_same_formulas(by_name[f"{full.name}_{tier}"], full)
+                            for tier in specialise.TIERS)))
+    return out
+
+
+def _same_formulas(part: Kernel, full: Kernel) -> bool:
+    """Each output of `part`, expanded to the inputs, is `full`'s."""
+    return all(part.expanded(o) == full.expanded(o) for o in part.outputs)
+
+
 def proofs():
     """(claim, passed) pairs for the rigid-body kernels."""
     out = _derivation_checks()
     sliding, sticking = KERNELS
     out += _kernel_checks(sliding, False)
     out += _kernel_checks(sticking, True, sliding)
-    return out
+    return out + _specialised_checks()

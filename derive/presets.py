@@ -34,7 +34,7 @@ from __future__ import annotations
 import sympy as sp
 
 from . import frame as f
-from . import particle, planar
+from . import particle, planar, specialise
 from .frame import (
     I1, I2, M, Pn, Pt, Px, Py, TL, TLm, TLn, TLt, V1x, V1y, V2x, V2y, W1, W2,
     dvx, dvy, e, e_m, gamma, gn, gt, gx, gy, j1, j2, k1, k2, m1, m2, mu, mu_c,
@@ -177,6 +177,7 @@ def sideswipe_kernel() -> Kernel:
 
 
 KERNELS = (sideswipe_kernel(),)
+EMITTED = (specialise.normal_form(KERNELS[0]),)  # what generated/presets.py holds
 
 
 # ---------------------------------------------------------------- proofs

@@ -9,7 +9,7 @@ the parallel one above.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable
 
 import generated
@@ -32,44 +32,6 @@ SERIAL_BELOW = 64
 OUTPUTS = ("V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M",
            "mu", "mu_c", "dV1", "dV2", "TL", "TLn", "TLt", "TLm")
 
-
-@dataclass(frozen=True)
-class KernelSet:
-    """One generated kernel: per-scene function, batch drivers, names."""
-
-    scene: Callable
-    batch: Callable
-    serial: Callable
-    inputs: tuple[str, ...]
-    outputs: tuple[str, ...]
-
-
-def _kernel_set(module, name: str) -> KernelSet:
-    upper = name.upper()
-    return KernelSet(
-        scene=getattr(module, name),
-        batch=getattr(module, f"{name}_batch"),
-        serial=getattr(module, f"{name}_batch_serial"),
-        inputs=getattr(module, f"{upper}_INPUTS"),
-        outputs=getattr(module, f"{upper}_OUTPUTS"),
-    )
-
-
-KERNELS = {
-    ("rigid", False): _kernel_set(planar, "rigid"),
-    ("rigid", True): _kernel_set(planar, "rigid_critical"),
-    ("particle", False): _kernel_set(particle, "particle"),
-    ("particle", True): _kernel_set(particle, "particle_critical"),
-    ("impac_sideswipe", False): _kernel_set(presets, "impac_sideswipe"),
-}
-
-DELTA_V = _kernel_set(delta_v, "delta_v_from_energy")
-
-INVERSE = {
-    "rigid": _kernel_set(inverse, "rigid_inverse"),
-    "particle": _kernel_set(inverse, "particle_inverse"),
-}
-RECONSTRUCT = _kernel_set(reconstruct, "reconstruct")
 
 # Output tiers of solve_batch(outputs=...): each adds to the one before.
 TIERS = {
@@ -97,6 +59,75 @@ def requested_outputs(outputs) -> tuple[tuple[str, ...], str]:
     tier = next(t for t, have in TIERS.items() if set(names) <= set(have))
     return names, tier
 
+
+@dataclass(frozen=True)
+class KernelSet:
+    """One generated kernel: per-scene function, batch drivers, names.
+
+    `inputs` are the batch columns, `outputs` the computed outputs and
+    `constants` the outputs the kernel fixes to a number (e_m = 1: M = 0).
+    A kernel in normal form (`arguments` not None) takes the normal's
+    components (nx, ny) in place of `gamma`: `unit_normal` forms them, and
+    `batch_normal`/`serial_normal` are its drivers that take them as given."""
+
+    scene: Callable
+    batch: Callable
+    serial: Callable
+    inputs: tuple[str, ...]
+    outputs: tuple[str, ...]
+    constants: dict = field(default_factory=dict)
+    arguments: tuple[str, ...] | None = None
+    batch_normal: Callable | None = None
+    serial_normal: Callable | None = None
+    unit_normal: Callable | None = None
+
+
+def _kernel_set(module, name: str) -> KernelSet:
+    upper = name.upper()
+    arguments = getattr(module, f"{upper}_ARGUMENTS", None)
+    normal = arguments is not None
+    return KernelSet(
+        scene=getattr(module, name),
+        batch=getattr(module, f"{name}_batch"),
+        serial=getattr(module, f"{name}_batch_serial"),
+        inputs=getattr(module, f"{upper}_INPUTS"),
+        outputs=getattr(module, f"{upper}_OUTPUTS"),
+        constants=getattr(module, f"{upper}_CONSTANTS", {}),
+        arguments=arguments,
+        batch_normal=getattr(module, f"{name}_batch_normal") if normal else None,
+        serial_normal=getattr(module, f"{name}_batch_normal_serial") if normal else None,
+        unit_normal=module.unit_normal if normal else None,
+    )
+
+
+def _forward_name(family: str, critical: bool, no_moment: bool, tier: str) -> str:
+    """Generated kernel name: rigid[_critical][_em1][_velocities|_impulses]."""
+    return (family + ("_critical" if critical else "") + ("_em1" if no_moment else "")
+            + ("" if tier == "energy" else f"_{tier}"))
+
+
+def _forward_kernels() -> dict:
+    """(family, critical, e_m = 1, tier) → KernelSet for every forward kernel."""
+    table = {}
+    for module, family, moment in ((planar, "rigid", (False, True)), (particle, "particle", (False,))):
+        for critical in (False, True):
+            for no_moment in moment:
+                for tier in TIERS:
+                    name = _forward_name(family, critical, no_moment, tier)
+                    table[(family, critical, no_moment, tier)] = _kernel_set(module, name)
+    table[("impac_sideswipe", False, False, "energy")] = _kernel_set(presets, "impac_sideswipe")
+    return table
+
+
+KERNELS = _forward_kernels()
+
+DELTA_V = _kernel_set(delta_v, "delta_v_from_energy")
+
+INVERSE = {
+    "rigid": _kernel_set(inverse, "rigid_inverse"),
+    "particle": _kernel_set(inverse, "particle_inverse"),
+}
+RECONSTRUCT = _kernel_set(reconstruct, "reconstruct")
 
 INVERSE_OUTPUTS = ("v1x", "v1y", "w1", "v2x", "v2y", "w2", "Pn", "Pt", "M",
                    "mu_c", "TL", "TLn", "TLt", "TLm")
@@ -128,10 +159,14 @@ def preset(model: str) -> tuple[str, dict]:
     return row["kernel"], {COEFFICIENT_INPUTS[k]: v for k, v in row["fixed"].items()}
 
 
-def kernel_for(model: str, critical: bool) -> KernelSet:
-    """The forward kernel for a model name and impulse-ratio mode; ValueError if unknown."""
+def kernel_for(model: str, critical: bool, no_moment: bool = False,
+               tier: str = "energy") -> KernelSet:
+    """The forward kernel of a kernel family for an impulse-ratio mode, e_m = 1
+    (rigid only: no moment impulse) and an output tier; a family without a
+    specialised kernel gets its full one. ValueError if the family is unknown."""
     _check_model(model)
-    return KERNELS[(model, bool(critical))]
+    key = (model, bool(critical), bool(no_moment) and model == "rigid", tier)
+    return KERNELS.get(key) or KERNELS[(model, bool(critical), False, "energy")]
 
 
 def inverse_kernel_for(model: str) -> KernelSet:
@@ -140,14 +175,35 @@ def inverse_kernel_for(model: str) -> KernelSet:
     return INVERSE[model]
 
 
-def run_batch(ks: KernelSet, inputs: list[np.ndarray]) -> tuple[dict, np.ndarray, np.ndarray]:
-    """Run a kernel's batch driver over contiguous float64 input arrays of equal
-    length; returns (outputs by name, status, flags) in freshly allocated arrays."""
-    n = inputs[0].shape[0]
+def _as_input(value):
+    """A batch input as the drivers take it: a float scalar (the same for every
+    row) or a C-contiguous float64 array (one value per row)."""
+    if np.ndim(value) == 0:
+        return float(value)
+    return np.ascontiguousarray(value, dtype=np.float64)
+
+
+def run_batch(ks: KernelSet, inputs: list, n: int | None = None) -> tuple[dict, np.ndarray, np.ndarray]:
+    """Run a kernel's batch driver over `inputs` (in `ks.inputs` order; each a
+    float64 array of the batch length or a scalar for every row) and return
+    (computed outputs by name, status, flags) in freshly allocated arrays.
+
+    A kernel in normal form with one angle for every row gets the normal's
+    components once, not per row. Below `SERIAL_BELOW` rows the serial twin
+    runs (a parallel launch costs more than it saves)."""
+    inputs = [_as_input(x) for x in inputs]
+    if n is None:
+        n = max((x.shape[0] for x in inputs if isinstance(x, np.ndarray)), default=1)
     outs = {name: np.empty(n) for name in ks.outputs}
     status = np.empty(n, dtype=np.int32)
     flags = np.empty(n, dtype=np.int32)
-    driver = ks.serial if n < SERIAL_BELOW else ks.batch
+    serial = n < SERIAL_BELOW
+    driver = ks.serial if serial else ks.batch
+    if ks.arguments is not None:
+        at = ks.inputs.index("gamma")
+        if not isinstance(inputs[at], np.ndarray):
+            inputs[at:at + 1] = ks.unit_normal.py_func(inputs[at])
+            driver = ks.serial_normal if serial else ks.batch_normal
     driver(*inputs, *outs.values(), status, flags)
     return outs, status, flags
 
@@ -157,11 +213,16 @@ def run_one(ks: KernelSet, values: dict, outputs: tuple[str, ...]) -> dict:
 
     Returns every name of `outputs` (0.0 for a quantity the kernel's model does
     not have, NaN on a failed row) plus int `status` and `flags`."""
-    *outs, status, flags = ks.scene.py_func(*[float(values[name]) for name in ks.inputs])
+    args = [float(values[name]) for name in ks.inputs]
+    if ks.arguments is not None:
+        at = ks.inputs.index("gamma")
+        args[at:at + 1] = ks.unit_normal.py_func(args[at])
+    *outs, status, flags = ks.scene.py_func(*args)
     result = dict(zip(ks.outputs, outs))
     for name in outputs:
         if name not in result:
-            result[name] = 0.0 if status == 0 else math.nan
+            value = ks.constants.get(name, 0.0)
+            result[name] = value if status == 0 else math.nan
     result["status"], result["flags"] = int(status), int(flags)
     return result
 

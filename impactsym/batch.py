@@ -1,8 +1,16 @@
 """`solve_batch`: many scenes at once through the generated numba drivers.
 
 Columns follow conventions.md (struct of arrays, float64, angles in radians).
+A column may also be a scalar: the same value for every row, passed to the
+kernel as a scalar (never broadcast), so a constant angle costs one cos/sin.
 A bad row never stops the batch: it gets a non-zero `status` and NaN outputs.
 A bad *column* (missing, wrong length, not numeric) is a whole-batch error.
+
+Dispatch is per whole array, never per row in Python: the rows of a batch are
+grouped by (model, critical impulse ratio), each group runs the most
+specialised kernel that serves it (e_m = 1 for every row of the group: the
+kernel without a moment impulse; only the requested output tier), and the
+results come back in the original row order.
 """
 
 from __future__ import annotations
@@ -11,22 +19,26 @@ import numpy as np
 
 from . import _kernels
 
+CRITICAL = "critical"
+
 
 def _is_dataframe(obj) -> bool:
     return type(obj).__module__.startswith("pandas") and hasattr(obj, "columns")
 
 
-def _as_column(columns, name: str, n: int | None) -> np.ndarray:
-    """One input column as a contiguous float64 array; a scalar is broadcast."""
+def _as_column(columns, name: str, n: int | None):
+    """One input column: a float (a scalar column) or a 1-D float64 array."""
     if name not in columns:
         raise ValueError(f"{name}: missing column")
     try:
         arr = np.asarray(columns[name], dtype=np.float64)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{name}: not a numeric column ({exc})") from None
+    if arr.ndim == 0:
+        return float(arr)
     if arr.ndim > 1:
         raise ValueError(f"{name}: must be one-dimensional, got shape {arr.shape}")
-    if arr.ndim == 1 and n is not None and arr.shape[0] != n:
+    if n is not None and arr.shape[0] != n:
         raise ValueError(f"{name}: length {arr.shape[0]} differs from the other columns ({n})")
     return arr
 
@@ -38,24 +50,30 @@ def _row_count(columns, names) -> int:
     return max(lengths) if lengths else 1
 
 
-def _critical_mode(columns) -> bool:
-    """True when `mu` is the string "critical" (the sticking kernels)."""
-    mu = columns["mu"] if "mu" in columns else None
-    return isinstance(mu, str) and mu == "critical"
-
-
 def run_columns(ks: _kernels.KernelSet, columns, outputs, placeholders=()):
     """Validate `columns` for kernel `ks`, run it, and return `outputs` plus
     `status` and `flags` as the same kind of mapping (dict or DataFrame).
     Inputs named in `placeholders` are not read (the kernel ignores them)."""
     names = [k for k in ks.inputs if k not in placeholders]
     n = _row_count(columns, names)
-    inputs = [np.zeros(n) if name in placeholders else
-              np.ascontiguousarray(np.broadcast_to(_as_column(columns, name, n), (n,)))
+    inputs = [0.0 if name in placeholders else _as_column(columns, name, n)
               for name in ks.inputs]
-    outs, status, flags = _kernels.run_batch(ks, inputs)
-    result = {name: outs[name] if name in outs else _filler(status, n) for name in outputs}
+    result = _collect(ks, *_kernels.run_batch(ks, inputs, n), outputs, n)
+    return _like(columns, result)
+
+
+def _collect(ks, outs, status, flags, outputs, n) -> dict:
+    """The requested outputs of a kernel run: computed, constant (e_m = 1:
+    M = 0) or absent from the model (particles: yaw, M) → the constant or 0,
+    NaN on rows that were not solved."""
+    result = {name: outs[name] if name in outs else _filler(status, n, ks.constants.get(name, 0.0))
+              for name in outputs}
     result["status"], result["flags"] = status, flags
+    return result
+
+
+def _like(columns, result: dict):
+    """`result` as a DataFrame with the columns' index when they were one."""
     if _is_dataframe(columns):
         import pandas as pd
 
@@ -63,22 +81,26 @@ def run_columns(ks: _kernels.KernelSet, columns, outputs, placeholders=()):
     return result
 
 
-def solve_batch(columns, model: str = "rigid", outputs=None, engine: str = "local"):
+def solve_batch(columns, model="rigid", outputs=None, engine: str = "local"):
     """Solve one scene per row with the generated kernels.
 
-    `columns` maps input names to equal-length float64 arrays (a dict or a
-    pandas DataFrame): ``m1 m2 I1 I2 v1x v1y w1 v2x v2y w2 r1x r1y r2x r2y gamma
-    e mu e_m`` for the rigid model, ``m1 m2 v1x v1y v2x v2y gamma e mu`` for
-    particles. Units are consistent SI (kg, m, kg·m², m/s, rad/s) or US (slug,
-    ft, slug·ft², ft/s, rad/s); `gamma` (the normal angle Γ) is in radians. A
-    fixed body is ``m = I = inf``. ``mu="critical"`` uses the critical impulse
-    ratio (no sliding at separation) for every row; a scalar is broadcast.
+    `columns` maps input names to equal-length float64 arrays or scalars (a
+    dict or a pandas DataFrame): ``m1 m2 I1 I2 v1x v1y w1 v2x v2y w2 r1x r1y
+    r2x r2y gamma e mu e_m`` for the rigid model, ``m1 m2 v1x v1y v2x v2y gamma
+    e mu`` for particles. Units are consistent SI (kg, m, kg·m², m/s, rad/s)
+    or US (slug, ft, slug·ft², ft/s, rad/s); `gamma` (the normal angle Γ) is in
+    radians. A fixed body is ``m = I = inf``. A scalar is the same value for
+    every row. ``mu="critical"`` uses the critical impulse ratio (no sliding
+    at separation); `mu` may also be an array mixing numbers and "critical".
 
-    `model` is any model name a scene may give: a preset of the seed's models
-    fills the coefficients it fixes, which the columns must leave out
+    `model` is any model name a scene may give, or an array of them (one per
+    row): a preset of the seed's models fills the coefficients it fixes
     (``"limpert"`` and ``"impac"``: e = 0, μ = μ_c, e_m = 1; ``"macmillan"``:
-    e_m = 1); ``"impac_sideswipe"`` takes a ``slip`` column in place of ``e mu
-    e_m``; ``"brach"`` is ``"rigid"``.
+    e_m = 1); with one model for the batch the columns must leave those out,
+    in a mixed batch their values on the preset's rows must be the fixed
+    value or NaN. ``"impac_sideswipe"`` takes a ``slip`` column in place of
+    ``e mu e_m``; ``"brach"`` is ``"rigid"``. Mixed batches are grouped, each
+    group solved by its kernel, and returned in the original row order.
 
     `outputs` selects what is computed and returned: ``"velocities"`` (``V1x
     V1y W1 V2x V2y W2``), ``"impulses"`` (those plus ``Pn Pt M mu mu_c dV1
@@ -92,38 +114,128 @@ def solve_batch(columns, model: str = "rigid", outputs=None, engine: str = "loca
     Returns the same kind of mapping with the requested outputs (float64) and
     ``status`` and ``flags`` (int32): see `impactsym.codes` for their meanings.
     """
-    names, _tier = _kernels.requested_outputs(outputs)
+    names, tier = _kernels.requested_outputs(outputs)
     if engine == "dask":
         from .dask_engine import solve_batch_dask
 
         return solve_batch_dask(columns, model=model, outputs=outputs)
     if engine != "local":
         raise ValueError(f"engine: unknown engine {engine!r} (use local or dask)")
-    family, fixed = _kernels.preset(model)
-    merged = _with_fixed(columns, fixed, model) if fixed else columns
-    critical = _critical_mode(merged)
-    ks = _kernels.kernel_for(family, critical)
-    result = run_columns(ks, merged, names, ("mu",) if critical else ())
-    if merged is not columns and _is_dataframe(columns):
-        import pandas as pd
+    models, critical = _row_models(columns, model)
+    if isinstance(models, str) and not isinstance(critical, np.ndarray):
+        return _like(columns, _solve_group(columns, models, critical, names, tier, mixed=False))
+    return _like(columns, _solve_mixed(columns, models, critical, names, tier))
 
-        return pd.DataFrame(result, index=columns.index)
+
+def _row_models(columns, model):
+    """(model name or per-row array of names, critical flag or per-row bool array)."""
+    if not isinstance(model, str):
+        model = np.asarray(model, dtype=object)
+        if model.ndim != 1:
+            raise ValueError("model: a model name or a one-dimensional array of them")
+        uniq = set(model.tolist())
+        if len(uniq) == 1:
+            model = uniq.pop()
+    mu = columns["mu"] if "mu" in columns else None
+    if isinstance(mu, str):
+        if mu != CRITICAL:
+            raise ValueError(f"mu: a number or {CRITICAL!r}, got {mu!r}")
+        return model, True
+    if mu is None or np.ndim(mu) == 0 or np.asarray(mu).dtype != object:
+        return model, False
+    arr = np.asarray(mu, dtype=object)
+    crit = np.array([isinstance(v, str) for v in arr.tolist()])
+    bad = {v for v in arr[crit].tolist() if v != CRITICAL}
+    if bad:
+        raise ValueError(f"mu: a number or {CRITICAL!r}, got {sorted(bad)[0]!r}")
+    return model, bool(crit[0]) if crit.all() or not crit.any() else crit
+
+
+def _solve_group(columns, model: str, critical: bool, names, tier: str, mixed: bool) -> dict:
+    """Rows that share a model and impulse-ratio mode, through one kernel."""
+    family, fixed = _kernels.preset(model)
+    if fixed:
+        columns = _with_fixed(columns, fixed, model, mixed)
+    critical = critical or _is_critical(columns.get("mu"))
+    placeholders = ("mu",) if critical else ()
+    ks = _kernels.kernel_for(family, critical, _no_moment(columns), tier)
+    keys = [k for k in ks.inputs if k not in placeholders]
+    n = _row_count(columns, keys)
+    inputs = [0.0 if k in placeholders else _as_column(columns, k, n) for k in ks.inputs]
+    return _collect(ks, *_kernels.run_batch(ks, inputs, n), names, n)
+
+
+def _is_critical(mu) -> bool:
+    return isinstance(mu, str) and mu == CRITICAL
+
+
+def _no_moment(columns) -> bool:
+    """True when e_m = 1 on every row: the kernel without a moment impulse
+    serves the whole group (a group with any other e_m runs the general one)."""
+    if "e_m" not in columns or isinstance(columns["e_m"], str):
+        return False
+    em = np.asarray(columns["e_m"])
+    return em.dtype.kind in "fiu" and bool(np.all(em == 1.0))
+
+
+def _solve_mixed(columns, models, critical, names, tier: str) -> dict:
+    """Group rows by (model, critical), solve each group, scatter back in order."""
+    n = _row_count(columns, list(columns))
+    model_rows = np.broadcast_to(np.asarray(models, dtype=object), (n,))
+    crit_rows = np.broadcast_to(np.asarray(critical, dtype=bool), (n,))
+    keys = np.array([f"{m}\0{int(c)}" for m, c in zip(model_rows.tolist(), crit_rows.tolist())])
+    result = {name: np.empty(n) for name in names}
+    result["status"] = np.empty(n, dtype=np.int32)
+    result["flags"] = np.empty(n, dtype=np.int32)
+    for key in np.unique(keys):
+        rows = np.flatnonzero(keys == key)
+        model, crit = key.split("\0")
+        part = {k: _take(columns[k], rows, k) for k in columns}
+        if crit == "1":
+            part["mu"] = CRITICAL
+        solved = _solve_group(part, model, crit == "1", names, tier, mixed=True)
+        for name, values in solved.items():
+            result[name][rows] = values
     return result
 
 
-def _with_fixed(columns, fixed: dict, model: str) -> dict:
-    """The columns plus the coefficients a preset fixes; a column for one of
-    those is an error (it would be silently replaced)."""
+def _take(column, rows: np.ndarray, name: str):
+    """The group's rows of a column; a scalar stays a scalar."""
+    if isinstance(column, str) or np.ndim(column) == 0:
+        return column
+    arr = np.asarray(column)
+    if arr.dtype == object and name == "mu":
+        arr = arr[rows]
+        return np.array([np.nan if isinstance(v, str) else v for v in arr.tolist()], dtype=float)
+    return arr[rows]
+
+
+def _with_fixed(columns, fixed: dict, model: str, mixed: bool) -> dict:
+    """The columns plus the coefficients a preset fixes. With one model for the
+    batch a column for one of those is an error (it would be silently
+    replaced); in a mixed batch its values on these rows must be the fixed
+    value or NaN."""
     for name, value in fixed.items():
-        if name in columns:
+        if name not in columns:
+            continue
+        if not mixed or not _matches(columns[name], value):
             raise ValueError(f"{name}: the {model} model fixes {name} = {value}; "
-                             "leave the column out")
+                             "leave the column out" + (" or give that value or NaN" if mixed else ""))
     return {**{name: columns[name] for name in columns}, **fixed}
 
 
-def _filler(status: np.ndarray, n: int) -> np.ndarray:
-    """Zeros for a quantity the model does not have (particles: yaw, moment),
-    NaN on the rows that were not solved."""
-    out = np.zeros(n)
+def _matches(column, value) -> bool:
+    """Every entry of the column is `value` or NaN ("critical" for μ = μ_c)."""
+    if isinstance(value, str):
+        return isinstance(column, str) and column == value or (
+            np.ndim(column) > 0 and bool(np.all(np.isnan(np.asarray(column, dtype=float)))))
+    arr = np.asarray(column, dtype=float)
+    return bool(np.all((arr == value) | np.isnan(arr)))
+
+
+def _filler(status: np.ndarray, n: int, value: float = 0.0) -> np.ndarray:
+    """A quantity that is a fixed number on every solved row (e_m = 1: M = 0;
+    particles: no yaw, no moment), NaN on the rows that were not solved."""
+    out = np.full(n, value)
     out[status != 0] = np.nan
     return out
