@@ -205,30 +205,70 @@ def column_names(kernel: Kernel) -> tuple[str, ...]:
 
 def batch_function(kernel: Kernel, parallel: bool, style: Style = DEFAULT,
                    normal: bool = False) -> str:
-    """A batch driver into caller-owned outputs. Every input may be an array
-    (one value per row) or a scalar (the same for every row): `_at` picks.
-    A kernel in normal form gets drivers that take the angle (cos/sin per row)
-    and, with `normal`, drivers that take (nx, ny) as given."""
+    """A batch driver into caller-owned outputs. Every input column may be an
+    array (one value per row) or a scalar (the same for every row): `_at`
+    picks. A kernel in normal form gets drivers that take the angle (cos/sin
+    per row) and, with `normal`, drivers that take (nx, ny) as given.
+
+    The loop body is the kernel inlined without branches out of it: every
+    formula is evaluated on every row, a failed guard only sets the row's
+    status (the first one wins), and the outputs are selected at the end (NaN
+    on a failed row). Straight-line code is what lets LLVM vectorise the
+    loop; with numpy's error model a formula on a failed row gives NaN or inf,
+    never an exception, and is discarded."""
     name = f"{kernel.name}_batch" + ("_normal" if normal else "") + ("" if parallel else "_serial")
     args = [str(s) for s in kernel.inputs]
-    ins = args if normal or kernel.angle is None else list(column_names(kernel))
+    angle = kernel.angle is not None and not normal
+    columns = list(column_names(kernel)) if angle else args
     outs = [f"out_{s}" for s in kernel.output_names()] + ["out_status", "out_flags"]
     loop = "prange" if parallel else "range"
-    results = ", ".join(f"_r{i}" for i in range(len(outs)))
-    calls = [f"_at({a}, i)" for a in args]
-    body = []
-    if kernel.angle is not None and not normal:
-        at = args.index("nx")
-        body = [f"        _angle = _at({kernel.angle}, i)"]
-        calls[at:at + 2] = ["math.cos(_angle)", "math.sin(_angle)"]
+    ind = "        "
     lines = [f"@{style.jit(parallel)}",
-             f"def {name}({', '.join(ins + outs)}):",
+             f"def {name}({', '.join([f'c_{c}' for c in columns] + outs)}):",
              f'    """{"Parallel" if parallel else "Serial"} batch of `{kernel.name}`: '
              'one row per index, outputs written in place."""',
-             f"    for i in {loop}(out_status.shape[0]):", *body,
-             f"        {results} = {kernel.name}({', '.join(calls)})"]
-    lines += [f"        {o}[i] = _r{i}" for i, o in enumerate(outs)]
+             f"    for i in {loop}(out_status.shape[0]):"]
+    for a in args:
+        if angle and a in ("nx", "ny"):
+            continue
+        lines.append(f"{ind}{a} = _at(c_{a}, i)")
+    if angle:
+        lines += [f"{ind}{kernel.angle} = _at(c_{kernel.angle}, i)",
+                  f"{ind}nx = math.cos({kernel.angle})", f"{ind}ny = math.sin({kernel.angle})"]
+    lines += _straight_line_body(kernel, ind, style)
+    values = [str(s) for s in kernel.outputs]
+    lines += [f"{ind}ok = status == 0"]
+    lines += [f"{ind}{o}[i] = {v} if ok else math.nan" for o, v in zip(outs, values)]
+    lines += [f"{ind}out_status[i] = status", f"{ind}out_flags[i] = flags if ok else 0"]
     return "\n".join(lines) + "\n"
+
+
+def _status_lines(guard, indent: str, style: Style) -> list[str]:
+    """A guard as a status update: the first failed guard sets the status."""
+    cond = " & ".join(f"({style.code(c)})" for c in guard.conditions)
+    return [f"{indent}if (status == 0) & (not ({cond})):",
+            f"{indent}    status = {STATUS[guard.status]}  # {guard.status}"]
+
+
+def _straight_line_body(kernel: Kernel, ind: str, style: Style) -> list[str]:
+    """Checks, formulas and flags of the kernel as straight-line code setting
+    `status` and `flags` (see `batch_function`)."""
+    lines = [f"{ind}status = 0"]
+    for guard in kernel.checks:
+        lines += _status_lines(guard, ind, style)
+    temps = sp.numbered_symbols("_t")
+    for block in kernel.blocks:
+        lines += _block_lines(block, temps, ind, style)
+        if block.guard is not None:
+            lines += _status_lines(block.guard, ind, style)
+    lines.append(f"{ind}flags = 0")
+    for flag, conditions in kernel.flags:
+        cond = " | ".join(f"({style.code(c)})" for c in conditions)
+        lines += [f"{ind}if {cond}:", f"{ind}    flags |= {FLAGS[flag]}  # {flag}"]
+    total = " + ".join(str(s) for s in kernel.finite_checked())
+    lines += [f"{ind}if (status == 0) & (not math.isfinite({total})):",
+              f"{ind}    status = {STATUS['OVERFLOW']}  # OVERFLOW"]
+    return lines
 
 
 # A driver input is an array (one value per row) or a scalar (one value for

@@ -79,13 +79,14 @@ def fix_inputs(kernel: Kernel, name: str, values: dict, doc: str) -> Kernel:
         (kernel.public_name(s), float(known[s])) for s in kernel.outputs if s in known)
     flags = tuple((flag, tuple(c for c in (x.xreplace(known) for x in conds) if c is not sp.false))
                   for flag, conds in kernel.flags)
-    return replace(
+    fixed = replace(
         kernel, name=name, doc=f"{kernel.doc} {doc}",
         inputs=tuple(s for s in kernel.inputs if s not in values),
         checks=tuple(g for g in (_fixed_guard(g, known) for g in kernel.checks) if g),
         blocks=tuple(blocks), outputs=outputs, constants=constants,
         finite=tuple(s for s in kernel.finite_checked() if s not in known),
         flags=tuple((flag, conds) for flag, conds in flags if conds))
+    return prune(fixed, name, fixed.output_names() + tuple(n for n, _ in constants))
 
 
 def _fixed_guard(guard: Guard | None, known: dict) -> Guard | None:
@@ -109,9 +110,9 @@ def _evaluate(cond):
     return cond
 
 
-def prune(kernel: Kernel, name: str, outputs: tuple[str, ...], doc: str) -> Kernel:
+def prune(kernel: Kernel, name: str, outputs: tuple[str, ...], doc: str = "") -> Kernel:
     """`kernel` computing only the outputs named in `outputs` (public names),
-    plus whatever its guards and flags need."""
+    plus whatever its guards and flags need; `doc` is added to its docstring."""
     keep = tuple(s for s in kernel.outputs if kernel.public_name(s) in outputs)
     needed = set(keep)
     for guard in kernel.checks:
@@ -129,7 +130,7 @@ def prune(kernel: Kernel, name: str, outputs: tuple[str, ...], doc: str) -> Kern
             blocks.append(Block(assigns, block.guard))
     computed = {s for b in blocks for s, _ in b.assigns}
     return replace(
-        kernel, name=name, doc=f"{kernel.doc} {doc}", blocks=tuple(reversed(blocks)),
+        kernel, name=name, doc=f"{kernel.doc} {doc}".rstrip(), blocks=tuple(reversed(blocks)),
         outputs=keep, constants=tuple((n, v) for n, v in kernel.constants if n in outputs),
         finite=tuple(s for s in kernel.finite_checked() if s in computed))
 
