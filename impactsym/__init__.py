@@ -11,6 +11,8 @@ on vehicle 1; lower case initial, upper case final).
     import impactsym
     result = impactsym.solve("examples/two_car_us.json")
     table = impactsym.solve_batch(columns, model="rigid")
+    grid = impactsym.sweep("examples/two_car_us.json", e=[0.1, 0.2], mu=[0.0, 0.3])
+    draws = impactsym.sample("examples/two_car_us.json", {"e": ("uniform", 0, 0.3)}, 1000, seed=1)
 """
 
 from .batch import solve_batch
@@ -25,12 +27,13 @@ from .reconstruct import reconstruct, reconstruct_batch
 from .result import Result
 from .scene import MODELS, Impact, Scene, SceneError, Vehicle, load_scene
 from .single import solve
+from .sweep import percentiles, sample, sweep
 
 __version__ = "0.1.0"
 
 __all__ = [
     "FLAG_MESSAGES", "MODELS", "STATUS_MESSAGES", "Impact", "Result", "Scene", "SceneError",
     "Vehicle", "compare", "crash3", "delta_v_from_energy", "describe_flags", "describe_status",
-    "explore", "invert", "invert_batch", "load_scene", "plot", "reconstruct", "reconstruct_batch",
-    "solve", "solve_batch",
+    "explore", "invert", "invert_batch", "load_scene", "percentiles", "plot", "reconstruct",
+    "reconstruct_batch", "sample", "solve", "solve_batch", "sweep",
 ]
