@@ -13,6 +13,7 @@ import sys
 SUBCOMMANDS = {
     "accuracy": "benchmarks.accuracy",
     "inverse": "benchmarks.inverse",
+    "performance": "benchmarks.performance",
 }
 
 

@@ -66,7 +66,9 @@ def _collect(ks, outs, status, flags, outputs, n) -> dict:
     """The requested outputs of a kernel run: computed, constant (e_m = 1:
     M = 0) or absent from the model (particles: yaw, M) → the constant or 0,
     NaN on rows that were not solved."""
-    result = {name: outs[name] if name in outs else _filler(status, n, ks.constants.get(name, 0.0))
+    failed = status != 0
+    failed = failed if failed.any() else None
+    result = {name: outs[name] if name in outs else _filler(failed, n, ks.constants.get(name, 0.0))
               for name in outputs}
     result["status"], result["flags"] = status, flags
     return result
@@ -233,9 +235,11 @@ def _matches(column, value) -> bool:
     return bool(np.all((arr == value) | np.isnan(arr)))
 
 
-def _filler(status: np.ndarray, n: int, value: float = 0.0) -> np.ndarray:
+def _filler(failed: np.ndarray | None, n: int, value: float = 0.0) -> np.ndarray:
     """A quantity that is a fixed number on every solved row (e_m = 1: M = 0;
-    particles: no yaw, no moment), NaN on the rows that were not solved."""
-    out = np.full(n, value)
-    out[status != 0] = np.nan
+    particles: no yaw, no moment), NaN on the `failed` rows (None: no row
+    failed). Zeros come from np.zeros: fresh zero pages, not a pass over memory."""
+    out = np.zeros(n) if value == 0.0 else np.full(n, value)
+    if failed is not None:
+        out[failed] = np.nan
     return out
