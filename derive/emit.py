@@ -159,6 +159,25 @@ def _block_lines(block, temps, indent: str, style: Style) -> list[str]:
     return lines
 
 
+def _program_lines(kernel: Kernel, ind: str, style: Style, guard_lines, either: str) -> list[str]:
+    """Checks, blocks (CSE per block) and flags of a kernel, in order; a guard
+    becomes `guard_lines(guard)`, and a flag's conditions are joined by
+    `either` (" or " in the per-scene function, " | " in straight-line code)."""
+    lines = []
+    for guard in kernel.checks:
+        lines += guard_lines(guard)
+    temps = sp.numbered_symbols("_t")
+    for block in kernel.blocks:
+        lines += _block_lines(block, temps, ind, style)
+        if block.guard is not None:
+            lines += guard_lines(block.guard)
+    lines.append(f"{ind}flags = 0")
+    for flag, conditions in kernel.flags:
+        cond = either.join(f"({style.code(c)})" for c in conditions)
+        lines += [f"{ind}if {cond}:", f"{ind}    flags |= {FLAGS[flag]}  # {flag}"]
+    return lines
+
+
 def scene_function(kernel: Kernel, style: Style = DEFAULT) -> str:
     """The per-scene function: checks, blocks with guards, flags, finite check."""
     args = ", ".join(str(s) for s in kernel.inputs)
@@ -168,17 +187,8 @@ def scene_function(kernel: Kernel, style: Style = DEFAULT) -> str:
              f'{ind}"""{kernel.doc}', "",
              f"{ind}Returns ({outs}, status, flags); a failed row has NaN outputs.",
              f'{ind}"""']
-    for guard in kernel.checks:
-        lines += _guard_lines(kernel, guard, ind, style)
-    temps = sp.numbered_symbols("_t")
-    for block in kernel.blocks:
-        lines += _block_lines(block, temps, ind, style)
-        if block.guard is not None:
-            lines += _guard_lines(kernel, block.guard, ind, style)
-    lines.append(f"{ind}flags = 0")
-    for name, conditions in kernel.flags:
-        cond = " or ".join(f"({style.code(c)})" for c in conditions)
-        lines += [f"{ind}if {cond}:", f"{ind}    flags |= {FLAGS[name]}  # {name}"]
+    lines += _program_lines(kernel, ind, style,
+                            lambda guard: _guard_lines(kernel, guard, ind, style), " or ")
     total = " + ".join(str(s) for s in kernel.finite_checked())
     lines += [f"{ind}if not math.isfinite({total}):",
               f"{ind}    return _{kernel.name}_failed({STATUS['OVERFLOW']})  # OVERFLOW",
@@ -254,17 +264,7 @@ def _straight_line_body(kernel: Kernel, ind: str, style: Style) -> list[str]:
     """Checks, formulas and flags of the kernel as straight-line code setting
     `status` and `flags` (see `batch_function`)."""
     lines = [f"{ind}status = 0"]
-    for guard in kernel.checks:
-        lines += _status_lines(guard, ind, style)
-    temps = sp.numbered_symbols("_t")
-    for block in kernel.blocks:
-        lines += _block_lines(block, temps, ind, style)
-        if block.guard is not None:
-            lines += _status_lines(block.guard, ind, style)
-    lines.append(f"{ind}flags = 0")
-    for flag, conditions in kernel.flags:
-        cond = " | ".join(f"({style.code(c)})" for c in conditions)
-        lines += [f"{ind}if {cond}:", f"{ind}    flags |= {FLAGS[flag]}  # {flag}"]
+    lines += _program_lines(kernel, ind, style, lambda guard: _status_lines(guard, ind, style), " | ")
     total = " + ".join(str(s) for s in kernel.finite_checked())
     lines += [f"{ind}if (status == 0) & (not math.isfinite({total})):",
               f"{ind}    status = {STATUS['OVERFLOW']}  # OVERFLOW"]
