@@ -18,8 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _kernels
-
-CRITICAL = "critical"
+from .scene import CRITICAL
 
 
 def _is_dataframe(obj) -> bool:
