@@ -220,12 +220,14 @@ def batch_function(kernel: Kernel, parallel: bool, style: Style = DEFAULT,
     picks. A kernel in normal form gets drivers that take the angle (cos/sin
     per row) and, with `normal`, drivers that take (nx, ny) as given.
 
-    The loop body is the kernel inlined without branches out of it: every
-    formula is evaluated on every row, a failed guard only sets the row's
-    status (the first one wins), and the outputs are selected at the end (NaN
-    on a failed row). Straight-line code is what lets LLVM vectorise the
+    The parallel loop body is the kernel inlined without branches out of it:
+    every formula is evaluated on every row, a failed guard only sets the
+    row's status (the first one wins), and the outputs are selected at the end
+    (NaN on a failed row). Straight-line code is what lets LLVM vectorise the
     loop; with numpy's error model a formula on a failed row gives NaN or inf,
-    never an exception, and is discarded."""
+    never an exception, and is discarded. The serial twin serves batches too
+    small for that to matter: it calls the per-scene function, rather than
+    repeating the kernel's code."""
     name = f"{kernel.name}_batch" + ("_normal" if normal else "") + ("" if parallel else "_serial")
     args = [str(s) for s in kernel.inputs]
     angle = kernel.angle is not None and not normal
@@ -245,11 +247,16 @@ def batch_function(kernel: Kernel, parallel: bool, style: Style = DEFAULT,
     if angle:
         lines += [f"{ind}{kernel.angle} = _at(c_{kernel.angle}, i)",
                   f"{ind}nx = math.cos({kernel.angle})", f"{ind}ny = math.sin({kernel.angle})"]
-    lines += _straight_line_body(kernel, ind, style)
-    values = [str(s) for s in kernel.outputs]
-    lines += [f"{ind}ok = status == 0"]
-    lines += [f"{ind}{o}[i] = {v} if ok else math.nan" for o, v in zip(outs, values)]
-    lines += [f"{ind}out_status[i] = status", f"{ind}out_flags[i] = flags if ok else 0"]
+    if parallel:
+        lines += _straight_line_body(kernel, ind, style)
+        values = [str(s) for s in kernel.outputs]
+        lines += [f"{ind}ok = status == 0"]
+        lines += [f"{ind}{o}[i] = {v} if ok else math.nan" for o, v in zip(outs, values)]
+        lines += [f"{ind}out_status[i] = status", f"{ind}out_flags[i] = flags if ok else 0"]
+    else:
+        results = [f"_r{k}" for k in range(len(outs))]
+        lines.append(f"{ind}{', '.join(results)} = {kernel.name}({', '.join(args)})")
+        lines += [f"{ind}{o}[i] = {r}" for o, r in zip(outs, results)]
     return "\n".join(lines) + "\n"
 
 

@@ -53,12 +53,16 @@ def run_columns(ks: _kernels.KernelSet, columns, outputs, placeholders=()):
     """Validate `columns` for kernel `ks`, run it, and return `outputs` plus
     `status` and `flags` as the same kind of mapping (dict or DataFrame).
     Inputs named in `placeholders` are not read (the kernel ignores them)."""
+    return _like(columns, _run(ks, columns, outputs, placeholders))
+
+
+def _run(ks: _kernels.KernelSet, columns, outputs, placeholders) -> dict:
+    """Validate `columns` for kernel `ks`, run it, collect `outputs` (a dict)."""
     names = [k for k in ks.inputs if k not in placeholders]
     n = _row_count(columns, names)
     inputs = [0.0 if name in placeholders else _as_column(columns, name, n)
               for name in ks.inputs]
-    result = _collect(ks, *_kernels.run_batch(ks, inputs, n), outputs, n)
-    return _like(columns, result)
+    return _collect(ks, *_kernels.run_batch(ks, inputs, n), outputs, n)
 
 
 def _collect(ks, outs, status, flags, outputs, n) -> dict:
@@ -160,10 +164,7 @@ def _solve_group(columns, model: str, critical: bool, names, tier: str, mixed: b
     critical = critical or _is_critical(columns.get("mu"))
     placeholders = ("mu",) if critical else ()
     ks = _kernels.kernel_for(family, critical, _no_moment(columns), tier)
-    keys = [k for k in ks.inputs if k not in placeholders]
-    n = _row_count(columns, keys)
-    inputs = [0.0 if k in placeholders else _as_column(columns, k, n) for k in ks.inputs]
-    return _collect(ks, *_kernels.run_batch(ks, inputs, n), names, n)
+    return _run(ks, columns, names, placeholders)
 
 
 def _is_critical(mu) -> bool:

@@ -28,6 +28,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Union
 
+import numpy as np
+
 if sys.version_info >= (3, 11):
     import tomllib
 else:
@@ -268,7 +270,7 @@ def _parse_scene(data: Any, source: Path | None, kind: str) -> Scene:
     """Validate a whole scene in scene-file form."""
     if not isinstance(data, Mapping):
         where = f"{source}: " if source else ""
-        raise SceneError(f"{where}a scene must be an object (a table of keys), got {_show(data)}")
+        raise SceneError(f"{where}a scene must be an object (a table of keys), got {show_value(data)}")
     model = _choice(data.get("model", "rigid"), "model", MODELS, "model")
     units = _choice(_require(data, "units", ""), "units", UNITS, "units")
     impact_data = _mapping(_require(data, "impact", ""), "impact")
@@ -323,8 +325,8 @@ def _unused_coefficients(data: Mapping, model: str) -> list[str]:
         if key not in data:
             continue
         if key in preset["fixed"] and data[key] != preset["fixed"][key]:
-            warnings.append(f"impact.{key} = {_show(data[key])} is not used: the {model} model "
-                            f"fixes it at {_show(preset['fixed'][key])}")
+            warnings.append(f"impact.{key} = {show_value(data[key])} is not used: the {model} model "
+                            f"fixes it at {show_value(preset['fixed'][key])}")
         elif key not in preset["fixed"] and key not in (*preset["required"], *preset["optional"]):
             warnings.append(f"impact.{key} is not used by the {model} model")
     return warnings
@@ -343,13 +345,13 @@ def _impulse_ratio(value: Any) -> Union[float, str]:
     try:
         return _number(value, "impact.impulse_ratio")
     except SceneError:
-        raise SceneError(f'must be a finite number or "critical", got {_show(value)}', "impact.impulse_ratio") from None
+        raise SceneError(f'must be a finite number or "critical", got {show_value(value)}', "impact.impulse_ratio") from None
 
 
 def _parse_vehicles(raw: Any, model: str, kind: str) -> tuple[Vehicle, Vehicle]:
     """Validate the list of exactly two vehicles; at most one may be fixed."""
     if not isinstance(raw, list):
-        raise SceneError(f"must be a list of exactly 2 vehicles, got {_show(raw)}", "vehicles")
+        raise SceneError(f"must be a list of exactly 2 vehicles, got {show_value(raw)}", "vehicles")
     if len(raw) != 2:
         raise SceneError(f"must be a list of exactly 2 vehicles, got {len(raw)}", "vehicles")
     first, second = (_parse_vehicle(entry, index, model, kind) for index, entry in enumerate(raw))
@@ -449,7 +451,7 @@ def _optional(data: Mapping, key: str, path: str, check, *, required: bool = Fal
 def _mapping(value: Any, path: str) -> Mapping:
     """``value`` if it is an object/table."""
     if not isinstance(value, Mapping):
-        raise SceneError(f"must be an object (a table of keys), got {_show(value)}", path)
+        raise SceneError(f"must be an object (a table of keys), got {show_value(value)}", path)
     return value
 
 
@@ -457,7 +459,7 @@ def _choice(value: Any, path: str, allowed: tuple[str, ...], what: str) -> str:
     """``value`` if it is one of the ``allowed`` strings (exact spelling)."""
     if not isinstance(value, str) or value not in allowed:
         options = " or ".join(f'"{option}"' for option in allowed)
-        raise SceneError(f"unknown {what} {_show(value)} (use {options})", path)
+        raise SceneError(f"unknown {what} {show_value(value)} (use {options})", path)
     return value
 
 
@@ -475,7 +477,7 @@ def _number(value: Any, path: str) -> float:
             number = math.inf
         if math.isfinite(number):
             return number
-    raise SceneError(f"must be a finite number, got {_show(value)}", path)
+    raise SceneError(f"must be a finite number, got {show_value(value)}", path)
 
 
 def _positive(value: Any, path: str) -> float:
@@ -486,7 +488,7 @@ def _positive(value: Any, path: str) -> float:
         number = math.nan
     if number > 0.0:
         return number
-    raise SceneError(f"must be a positive finite number, got {_show(value)}", path)
+    raise SceneError(f"must be a positive finite number, got {show_value(value)}", path)
 
 
 def _vector(value: Any, path: str) -> tuple[float, float]:
@@ -496,21 +498,21 @@ def _vector(value: Any, path: str) -> tuple[float, float]:
             return (_number(value[0], path), _number(value[1], path))
         except SceneError:
             pass
-        raise SceneError(f"must be a list of 2 finite numbers, got {_show(value)}", path)
-    raise SceneError(f"must be a list of 2 numbers, got {_show(value)}", path)
+        raise SceneError(f"must be a list of 2 finite numbers, got {show_value(value)}", path)
+    raise SceneError(f"must be a list of 2 numbers, got {show_value(value)}", path)
 
 
 def _flag(value: Any, path: str) -> bool:
     """``value`` if it is a bool."""
     if not isinstance(value, bool):
-        raise SceneError(f"must be true or false, got {_show(value)}", path)
+        raise SceneError(f"must be true or false, got {show_value(value)}", path)
     return value
 
 
 def _name(value: Any, path: str) -> str:
     """``value`` if it is a non-empty string."""
     if not isinstance(value, str) or not value.strip():
-        raise SceneError(f"must be a non-empty string, got {_show(value)}", path)
+        raise SceneError(f"must be a non-empty string, got {show_value(value)}", path)
     return value
 
 
@@ -519,8 +521,10 @@ def _crush(value: Any, path: str) -> Mapping:
     return _mapping(value, path)
 
 
-def _show(value: Any) -> str:
+def show_value(value: Any) -> str:
     """A short, one-line rendering of a scene value for error messages."""
+    if isinstance(value, np.ndarray):
+        return f"an array of shape {value.shape}"
     if isinstance(value, str):
         text = repr(value)
     else:

@@ -44,7 +44,7 @@ import numpy as np
 
 from . import _kernels
 from .batch import solve_batch
-from .scene import CRITICAL, load_scene
+from .scene import CRITICAL, load_scene, show_value
 
 __all__ = ["sweep", "sample", "percentiles", "GridPlan", "SamplePlan", "collect", "summarize",
            "write_frame",
@@ -246,9 +246,9 @@ def _grid_values(name: str, kernel: str, raw):
     elif isinstance(raw, Iterable) and not isinstance(raw, (str, bytes, Mapping)):
         items = list(raw)
     else:
-        raise ValueError(f"{name}: expected a scalar or a 1-D sequence of {expected}, got {_show(raw)}")
+        raise ValueError(f"{name}: expected a scalar or a 1-D sequence of {expected}, got {show_value(raw)}")
     if isinstance(items, np.ndarray) and items.ndim != 1 or len(items) == 0:
-        raise ValueError(f"{name}: expected a non-empty 1-D sequence of {expected}, got {_show(raw)}")
+        raise ValueError(f"{name}: expected a non-empty 1-D sequence of {expected}, got {show_value(raw)}")
     if isinstance(items, np.ndarray):
         return items.astype(np.float64)
     if critical_ok and any(isinstance(v, str) and v == CRITICAL for v in items):
@@ -259,16 +259,8 @@ def _grid_values(name: str, kernel: str, raw):
 
 def _float(name: str, value, expected: str) -> float:
     if not _is_number(value):
-        raise ValueError(f"{name}: values must be {expected}, got {_show(value)}")
+        raise ValueError(f"{name}: values must be {expected}, got {show_value(value)}")
     return float(value)
-
-
-def _show(value) -> str:
-    """A short one-line rendering of a value for an error message."""
-    if isinstance(value, np.ndarray):
-        return f"an array of shape {value.shape}"
-    text = " ".join(repr(value).split())
-    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def _check_outputs(outputs) -> tuple[str, ...]:
@@ -377,9 +369,9 @@ class SamplePlan:
         """Check names, distributions, ``n`` and ``seed``; see `sample`."""
         _require("pandas", "sweep", "sample")
         if not _is_integer(n) or n < 1:
-            raise ValueError(f"n: must be a positive integer, got {_show(n)}")
+            raise ValueError(f"n: must be a positive integer, got {show_value(n)}")
         if seed is not None and (not _is_integer(seed) or seed < 0):
-            raise ValueError(f"seed: must be a non-negative integer or None, got {_show(seed)}")
+            raise ValueError(f"seed: must be a non-negative integer or None, got {show_value(seed)}")
         _check_outputs(outputs)
         if not isinstance(dists, Mapping) or not dists:
             raise ValueError("dists: must map at least one input name to a distribution")
@@ -426,14 +418,14 @@ def _distribution(name: str, spec) -> tuple[str, tuple[float, ...]]:
     kinds = ", ".join(DISTRIBUTIONS)
     if not isinstance(spec, (tuple, list)) or not spec or not isinstance(spec[0], str):
         raise ValueError(f"{name}: expected a tuple (kind, parameters...) with kind one of {kinds}, "
-                         f"got {_show(spec)}")
+                         f"got {show_value(spec)}")
     kind, params = spec[0], spec[1:]
     if kind not in DISTRIBUTIONS:
         raise ValueError(f"{name}: unknown distribution {kind!r} (use one of {kinds})")
     wanted = DISTRIBUTIONS[kind]
     if len(params) != len(wanted) or not all(_is_number(p) and math.isfinite(p) for p in params):
         raise ValueError(f"{name}: {kind} takes {len(wanted)} finite numbers ({', '.join(wanted)}), "
-                         f"got {_show(tuple(params))}")
+                         f"got {show_value(tuple(params))}")
     params = tuple(float(p) for p in params)
     problem = _distribution_problem(kind, params)
     if problem:
@@ -461,14 +453,14 @@ def _spans(rows: int, chunk_size: int) -> Iterator[tuple[int, int]]:
 def _frames(plan, engine: str, chunk_size: int) -> Iterator:
     """Every chunk of ``plan`` solved, in row order, by the chosen engine."""
     if not _is_integer(chunk_size) or chunk_size < 1:
-        raise ValueError(f"chunk_size: must be a positive integer, got {_show(chunk_size)}")
+        raise ValueError(f"chunk_size: must be a positive integer, got {show_value(chunk_size)}")
     spans = _spans(plan.rows, chunk_size)
     if engine == "dask":
         from .dask_engine import chunk_frames
 
         return chunk_frames(plan, spans)
     if engine != "local":
-        raise ValueError(f"engine: unknown engine {_show(engine)} (use local or dask)")
+        raise ValueError(f"engine: unknown engine {show_value(engine)} (use local or dask)")
     return (plan.frame(start, stop) for start, stop in spans)
 
 
@@ -655,7 +647,7 @@ def _check_q(q) -> tuple[float, ...]:
     except (TypeError, ValueError):
         values = ()
     if not values or not all(0.0 <= v <= 100.0 for v in values):
-        raise ValueError(f"q: percentiles must be between 0 and 100, got {_show(q)}")
+        raise ValueError(f"q: percentiles must be between 0 and 100, got {show_value(q)}")
     return values
 
 
