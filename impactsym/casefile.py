@@ -15,7 +15,8 @@ A *leaf* is one number of a scene, named by its path as written
 :class:`LeafReader` reads and checks leaves and keeps them, in scene units, as
 :class:`Leaf` records. The alternative forms (``weight`` for ``mass``,
 ``radius_of_gyration`` for ``yaw_inertia``, ``{"speed", "direction"}`` for a
-velocity, ``{"forward", "left"}`` for an impact point in the vehicle frame,
+velocity, ``{"forward", "left"}`` or ``{"distance", "angle"}`` for an impact
+point in the vehicle frame,
 either sense of ``normal_angle``) are computed from the leaves by
 :func:`vehicle_state` and :func:`used_normal_angle` with NumPy operations that
 take floats and arrays alike: the nominal scene and a batch of uncertainty
@@ -24,7 +25,8 @@ draws go through the same code.
 Conventions: directions and headings are degrees counter-clockwise from +x;
 ``heading`` is the direction of the vehicle's longitudinal axis (where its
 front points); in the vehicle frame ``forward`` is along the heading and
-``left`` 90° counter-clockwise from it. ``mass = weight / g_n`` with
+``left`` 90° counter-clockwise from it; ``angle`` is counter-clockwise from
+the heading (to the left). ``mass = weight / g_n`` with
 g_n = 9.80665 m/s² (:data:`impactsym.units.STANDARD_GRAVITY`).
 """
 
@@ -55,6 +57,15 @@ VEHICLE_KEYS = ("name", "fixed", "mass", "weight", "yaw_inertia", "radius_of_gyr
                 "final_yaw_rate", "crush", "length", "width")
 POLAR_KEYS = ("speed", "direction")
 VEHICLE_FRAME_KEYS = ("forward", "left")
+VEHICLE_POLAR_KEYS = ("distance", "angle")
+_FORM_DIMENSIONS = {"speed": "speed", "direction": "angle", "forward": "length", "left": "length",
+                    "distance": "length", "angle": "angle"}
+
+
+def _forms(kind: str) -> tuple[tuple[str, ...], ...]:
+    """The table forms of a vector field besides [x, y]."""
+    return {"velocity": (POLAR_KEYS,), "impact_point": (VEHICLE_FRAME_KEYS, VEHICLE_POLAR_KEYS),
+            "": ()}[kind]
 #: Distribution kinds and their parameters (in the field's units).
 DISTRIBUTIONS = {"normal": ("mean", "sd"), "uniform": ("low", "high"),
                  "triangular": ("low", "mode", "high")}
@@ -118,25 +129,28 @@ class LeafReader:
         self.leaves[path] = leaf
         return leaf.nominal
 
-    def vector(self, value: Any, path: str, dimension: str, polar: tuple[str, str] | None = None,
-               polar_dimensions: tuple[str, str] = ("speed", "angle")) -> None:
+    def vector(self, value: Any, path: str, dimension: str, polar: str | None = None) -> None:
         """A 2-vector leaf pair: ``[x, y]`` (leaves ``path[0]``, ``path[1]``) or,
-        when ``polar`` names its keys, a table of them (leaves ``path.key``)."""
+        for ``polar="velocity"``, ``{speed, direction}``, for
+        ``polar="impact_point"``, ``{forward, left}`` or ``{distance, angle}``
+        (leaves ``path.key``)."""
         if isinstance(value, (list, tuple)):
             if len(value) != 2:
                 raise SceneError(f"must be a list of 2 numbers, got {show_value(value)}", path)
             for i, item in enumerate(value):
                 self.number(item, f"{path}[{i}]", dimension)
             return
-        if polar and isinstance(value, Mapping) and not set(value) & set(DISTRIBUTIONS):
-            check_keys(value, polar, path)
-            for key, key_dimension in zip(polar, polar_dimensions):
+        forms = _forms(polar or ())
+        if forms and isinstance(value, Mapping) and not set(value) & set(DISTRIBUTIONS):
+            keys = next((form for form in forms if set(value) & set(form)), forms[0])
+            check_keys(value, keys, path)
+            for key in keys:
                 if key not in value:
                     raise SceneError("missing", f"{path}.{key}")
-                domain = "nonnegative" if key == "speed" else "any"
-                self.number(value[key], f"{path}.{key}", key_dimension, domain)
+                domain = "nonnegative" if key in ("speed", "distance") else "any"
+                self.number(value[key], f"{path}.{key}", _FORM_DIMENSIONS[key], domain)
             return
-        forms = "a list of 2 numbers" + (f" or {{{', '.join(polar)}}}" if polar else "")
+        forms = "a list of 2 numbers" + "".join(f" or {{{', '.join(form)}}}" for form in forms)
         note = "; a distribution goes on each number" if isinstance(value, Mapping) else ""
         raise SceneError(f"must be {forms}{note}, got {show_value(value)}", path)
 
@@ -275,12 +289,22 @@ def _impact_point(values: Mapping, p: str, heading):
     path = f"{p}.impact_point"
     if f"{path}[0]" in values:
         return values[f"{path}[0]"], values[f"{path}[1]"]
-    if f"{path}.forward" in values:
-        forward, left = values[f"{path}.forward"], values[f"{path}.left"]
+    if f"{path}.forward" in values or f"{path}.distance" in values:
+        forward, left = _vehicle_frame(values, path)
         angle = np.deg2rad(heading)
         c, s = np.cos(angle), np.sin(angle)
         return forward * c - left * s, forward * s + left * c
     return 0.0, 0.0
+
+
+def _vehicle_frame(values: Mapping, path: str):
+    """(forward, left) of a vehicle-frame impact point: given, or
+    ``distance·(cos a, sin a)`` from ``{distance, angle}`` (a in degrees,
+    counter-clockwise from the heading)."""
+    if f"{path}.forward" in values:
+        return values[f"{path}.forward"], values[f"{path}.left"]
+    distance, angle = values[f"{path}.distance"], np.deg2rad(values[f"{path}.angle"])
+    return distance * np.cos(angle), distance * np.sin(angle)
 
 
 def used_normal_angle(given, r1, r2):

@@ -41,8 +41,8 @@ else:
 
 from generated.presets import COEFFICIENT_INPUTS, PRESETS
 
-from .casefile import (COEFFICIENT_KEYS, CRUSH_LEAVES, IMPACT_KEYS, POLAR_KEYS, TOP_KEYS,
-                       VEHICLE_FRAME_KEYS, VEHICLE_KEYS, Leaf, LeafReader, check_keys,
+from .casefile import (COEFFICIENT_KEYS, CRUSH_LEAVES, IMPACT_KEYS, TOP_KEYS, VEHICLE_KEYS,
+                       Leaf, LeafReader, check_keys,
                        domain_reasons, parse_correlations, unknown_key, used_normal_angle,
                        vehicle_state)
 from .errors import SceneError, show_value
@@ -496,16 +496,15 @@ def _read_vehicle(data: Mapping, index: int, fixed: bool, reading: _Reading) -> 
             leaves.number(data[key], f"{path}.{key}", dimension, "positive")
     for key in ("velocity", "final_velocity"):
         if key in data:
-            leaves.vector(data[key], f"{path}.{key}", "speed", POLAR_KEYS)
+            leaves.vector(data[key], f"{path}.{key}", "speed", "velocity")
     for key, dimension in (("yaw_rate", "rate"), ("final_yaw_rate", "rate"), ("heading", "angle")):
         if key in data:
             leaves.number(data[key], f"{path}.{key}", dimension)
     if "impact_point" in data:
-        leaves.vector(data["impact_point"], f"{path}.impact_point", "length", VEHICLE_FRAME_KEYS,
-                      ("length", "length"))
+        leaves.vector(data["impact_point"], f"{path}.impact_point", "length", "impact_point")
         if isinstance(data["impact_point"], Mapping) and "heading" not in data:
-            raise SceneError("in the vehicle frame ({forward, left}) it needs the vehicle's "
-                             "heading", f"{path}.impact_point")
+            raise SceneError("in the vehicle frame ({forward, left} or {distance, angle}) it needs "
+                             f"the vehicle's heading ({path}.heading)", f"{path}.impact_point")
     extra = {key: leaves.number(data[key], f"{path}.{key}", "length", "positive")
              for key in ("length", "width") if key in data}
     if "crush" in data:

@@ -13,7 +13,11 @@ serves the process (:func:`registry`).
 Conventions: ``lb`` is the pound-mass and ``lbf`` the pound-force (pint's
 definitions; 1 lbf = 1 lb × standard gravity). A slug is lbf·s²/ft. Scene
 angles are in degrees, yaw rates in rad/s. ``weight`` is a force;
-:data:`STANDARD_GRAVITY` turns it into a mass.
+:data:`STANDARD_GRAVITY` turns it into a mass. A mass field given a force, or
+a weight field given a mass, is converted with standard gravity too: with
+g_n a pound of mass weighs exactly a pound-force, so ``"weight": "3451 lb"``
+and ``"mass": "3451 lb"`` mean the same vehicle (only bare numbers depend on
+the field: a bare ``weight`` is lbf or N, a bare ``mass`` slug or kg).
 """
 
 from __future__ import annotations
@@ -88,6 +92,12 @@ def to_scene_units(text: str, path: str, dimension: str, system: str) -> float:
     adds the field path) when pint cannot read it or its dimension is wrong."""
     quantity = _parse(text)
     found = _kind(quantity)
+    if {found, dimension} == {"mass", "force"}:
+        # standard gravity: a pound of mass weighs a pound-force, so "3451 lb"
+        # as a weight and "3451 lbf" as a mass both give the same mass
+        gravity = registry().Quantity(STANDARD_GRAVITY, "m/s**2")
+        quantity = quantity * gravity if found == "mass" else quantity / gravity
+        found = dimension
     if found != dimension and not _same_length(found, dimension):
         need = DIMENSIONS[dimension]
         got = DIMENSIONS[found].what if found else f"dimension {quantity.dimensionality}"
