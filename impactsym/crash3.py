@@ -47,7 +47,7 @@ from generated.codes import STATUS_PDOF_BEYOND_LIMIT
 
 from . import _kernels
 from .codes import describe_status
-from .result import UNIT_LABELS
+from .result import UNIT_LABELS, road_speed_rows
 from .scene import Scene, SceneError, Vehicle, _mapping, _number, _positive, load_scene, scene_data
 from .single import solve
 
@@ -137,6 +137,8 @@ class Crash3Result:
             (f"  with 1 + tan^2(alpha) [{energy}]", one.crush_energy, two.crush_energy),
             ("effective-mass factor gamma", one.mass_factor, two.mass_factor),
             (f"|delta-V| [{speed}]", one.delta_v_magnitude, two.delta_v_magnitude),
+            *road_speed_rows(self.units, [("|delta-V|", (one.delta_v_magnitude,
+                                                         two.delta_v_magnitude))]),
             (f"delta-V x [{speed}]", one.delta_v[0], two.delta_v[0]),
             (f"delta-V y [{speed}]", one.delta_v[1], two.delta_v[1]),
             ("PDOF implied by impulse-momentum [deg]", one.pdof_implied, two.pdof_implied),
