@@ -56,6 +56,8 @@ MODELS = tuple(PRESETS)
 UNITS = ("SI", "US")
 CRITICAL = "critical"
 KINDS = ("forward", "inverse", "reconstruct", "crash3")
+#: Vehicle entries Scene.to_dict leaves out for a kind that does not read them.
+_TO_DICT_LEFT_OUT = {"inverse": ("velocity", "yaw_rate"), "reconstruct": ("velocity",)}
 #: The command that reads each kind of scene (for "not used" warnings).
 COMMAND = {"forward": "solve", "inverse": "invert", "reconstruct": "reconstruct",
            "crash3": "crash3"}
@@ -179,11 +181,15 @@ class Scene:
     def to_dict(self) -> dict[str, Any]:
         """The scene in plain scene-file form (what :func:`load_scene` reads back):
         numbers in the scene's units, vectors in the scene frame, nominal values."""
+        vehicles = [vehicle.to_dict() for vehicle in self.vehicles]
+        for entry in vehicles:  # the initial motion is what these kinds compute
+            for key in _TO_DICT_LEFT_OUT.get(self.kind, ()):
+                entry.pop(key, None)
         data = {
             "model": self.model,
             "units": self.units,
             "impact": self.impact.to_dict(),
-            "vehicles": [vehicle.to_dict() for vehicle in self.vehicles],
+            "vehicles": vehicles,
         }
         data.update(self.extra)
         return data
