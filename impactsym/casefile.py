@@ -44,9 +44,20 @@ import numpy as np
 from .errors import SceneError, show_value
 from .units import GRAVITY, to_scene_units
 
-__all__ = ["Leaf", "LeafReader", "DISTRIBUTIONS", "TOP_KEYS", "IMPACT_KEYS", "VEHICLE_KEYS",
-           "COEFFICIENT_KEYS", "check_keys", "vehicle_state", "used_normal_angle",
-           "parse_correlations", "domain_reasons"]
+__all__ = [
+    "COEFFICIENT_KEYS",
+    "DISTRIBUTIONS",
+    "IMPACT_KEYS",
+    "TOP_KEYS",
+    "VEHICLE_KEYS",
+    "Leaf",
+    "LeafReader",
+    "check_keys",
+    "domain_reasons",
+    "parse_correlations",
+    "used_normal_angle",
+    "vehicle_state",
+]
 
 COEFFICIENT_KEYS = ("restitution", "impulse_ratio", "moment_restitution", "slip")
 TOP_KEYS = ("model", "units", "impact", "vehicles", "title", "description", "notes", "comment",

@@ -30,7 +30,7 @@ import sys
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Union
+from typing import Any
 
 import numpy as np
 
@@ -41,14 +41,38 @@ else:
 
 from generated.presets import COEFFICIENT_INPUTS, PRESETS
 
-from .casefile import (COEFFICIENT_KEYS, CRUSH_LEAVES, IMPACT_KEYS, TOP_KEYS, VEHICLE_KEYS,
-                       Leaf, LeafReader, check_keys,
-                       domain_reasons, parse_correlations, unknown_key, used_normal_angle,
-                       vehicle_state)
+from .casefile import (
+    COEFFICIENT_KEYS,
+    CRUSH_LEAVES,
+    IMPACT_KEYS,
+    TOP_KEYS,
+    VEHICLE_KEYS,
+    Leaf,
+    LeafReader,
+    check_keys,
+    domain_reasons,
+    parse_correlations,
+    unknown_key,
+    used_normal_angle,
+    vehicle_state,
+)
 from .errors import SceneError, show_value
 
-__all__ = ["SceneError", "Vehicle", "Impact", "Scene", "SceneColumns", "load_scene", "scene_data",
-           "scene_columns", "uses_yaw", "show_value", "MODELS", "UNITS", "KINDS"]
+__all__ = [
+    "KINDS",
+    "MODELS",
+    "UNITS",
+    "Impact",
+    "Scene",
+    "SceneColumns",
+    "SceneError",
+    "Vehicle",
+    "load_scene",
+    "scene_columns",
+    "scene_data",
+    "show_value",
+    "uses_yaw",
+]
 
 # Model names a scene may give (generated.presets.PRESETS): the general model
 # ("rigid" or "brach"), "particle", and the seed's named models as presets.
@@ -120,7 +144,7 @@ class Impact:
 
     normal_angle: float
     restitution: float | None
-    impulse_ratio: Union[float, str, None]
+    impulse_ratio: float | str | None
     moment_restitution: float | None = 1.0
     slip: float | None = None
 
@@ -230,7 +254,7 @@ class Scene:
         return self.family, impact.critical, values
 
 
-def load_scene(source: Union[Scene, Mapping, str, Path], kind: str = "forward") -> Scene:
+def load_scene(source: Scene | Mapping | str | Path, kind: str = "forward") -> Scene:
     """Read and validate a scene.
 
     ``source`` is a :class:`Scene` (its data read again), a mapping in
@@ -256,7 +280,7 @@ def load_scene(source: Union[Scene, Mapping, str, Path], kind: str = "forward") 
     raise TypeError(f"load_scene: expected a Scene, a mapping or a path, got {type(source).__name__}")
 
 
-def scene_data(source: Union[Scene, Mapping, str, Path]) -> Mapping:
+def scene_data(source: Scene | Mapping | str | Path) -> Mapping:
     """The scene-file mapping of ``source`` (a :class:`Scene`, a mapping or a
     ``.json``/``.toml`` path), not validated: what a scene gives, before its
     model's defaults and fixed coefficients are applied."""
@@ -409,7 +433,7 @@ def _coefficient(data: Mapping, key: str, preset: Mapping, reading: _Reading) ->
     return reading.leaves.number(data[key], path, "number")
 
 
-def _impulse_ratio(value: Any, reading: _Reading) -> Union[float, str]:
+def _impulse_ratio(value: Any, reading: _Reading) -> float | str:
     """A signed impulse ratio μ, or the string ``"critical"``."""
     if isinstance(value, str) and value == CRITICAL:
         return CRITICAL

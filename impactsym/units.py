@@ -26,8 +26,15 @@ import functools
 import math
 from dataclasses import dataclass
 
-__all__ = ["STANDARD_GRAVITY", "GRAVITY", "DIMENSIONS", "SCENE_UNITS", "Dimension",
-           "registry", "to_scene_units"]
+__all__ = [
+    "DIMENSIONS",
+    "GRAVITY",
+    "SCENE_UNITS",
+    "STANDARD_GRAVITY",
+    "Dimension",
+    "registry",
+    "to_scene_units",
+]
 
 #: Standard gravity g_n [m/s²] (exact, CGPM 1901): mass = weight / g_n.
 STANDARD_GRAVITY = 9.80665
@@ -77,7 +84,7 @@ SCENE_UNITS = {
 }
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def registry():
     """The process's one pint UnitRegistry, built on first use."""
     import pint
@@ -116,7 +123,7 @@ def _parse(text: str):
     ureg = registry()
     try:
         return ureg.Quantity(ureg(text))
-    except Exception as exc:  # pint raises many types (UndefinedUnitError, SyntaxError, ...)
+    except Exception as exc:  # noqa: BLE001 - pint raises many types (UndefinedUnitError, SyntaxError, ...)
         raise ValueError(f"must be a finite number or a number with a unit pint understands, "
                          f"got {text!r} ({_reason(exc)})") from None
 
@@ -130,7 +137,7 @@ def _kind(quantity) -> str | None:
     """The dimension (a key of :data:`DIMENSIONS`) of a pint Quantity, or None."""
     ureg = registry()
     if quantity.dimensionless:
-        factor, root = ureg.get_root_units(quantity.units)
+        _, root = ureg.get_root_units(quantity.units)
         return "angle" if "radian" in str(root) else "number"
     if quantity.dimensionality == ureg.get_dimensionality("1/[time]"):
         return "rate"
