@@ -31,7 +31,7 @@ version = release
 extensions = [
     "myst_nb",  # Markdown pages (MyST) and notebooks
     "sphinx.ext.autodoc",
-    "sphinx.ext.napoleon",  # the docstrings' plain style renders as is
+    "numpydoc",  # plain docstrings render as written; numpy sections if one has them
     "sphinx.ext.mathjax",
 ]
 
@@ -47,13 +47,16 @@ nb_execution_mode = "off"
 # Docstrings: `name` in a docstring is code, as it reads in the source.
 default_role = "code"
 autodoc_member_order = "bysource"
-autodoc_typehints = "description"
+autodoc_typehints = "signature"
 # Reading docstrings needs no compiler: numba is replaced by a stand-in while
 # autodoc imports the package (kernels are never called at build time).
 autodoc_mock_imports = ["numba"]
 autodoc_default_options = {"members": True, "undoc-members": False}
-napoleon_google_docstring = False
-napoleon_numpy_docstring = True
+# Members are listed by autodoc (:members:), not again in a numpydoc table.
+numpydoc_show_class_members = False
+numpydoc_class_members_toctree = False
+# Only the build's warnings decide; numpydoc's style checks are not run.
+numpydoc_validation_checks = set()
 
 html_theme = "alabaster"
 html_title = f"impactsym {release}"
