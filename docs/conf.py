@@ -37,8 +37,9 @@ extensions = [
 
 exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "**.ipynb_checkpoints"]
 
-# MyST: $...$ and $$...$$ math, anchors for headings (links to #sections).
-myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
+# MyST: $...$ and $$...$$ math, ::: fences for admonitions, anchors for
+# headings (links to #sections).
+myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence"]
 myst_heading_anchors = 3
 
 # Notebooks: render the stored outputs; never run a kernel at build time.
@@ -60,7 +61,6 @@ numpydoc_validation_checks = set()
 
 html_theme = "alabaster"
 html_title = f"impactsym {release}"
-html_static_path = []
 # MathJax is loaded from a CDN by the reader's browser; the build itself needs no network.
 
 # The docstrings are plain text, where |x| is an absolute value (|ΔV|, |P|,
