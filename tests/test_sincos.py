@@ -215,7 +215,7 @@ def test_every_multiple_of_half_pi_up_to_the_limit():
 
     with mpmath.workdps(40):
         half_pi = mpmath.pi / 2
-        xs = [float(k * half_pi) for k in range(0, 2**20 + 1)]
+        xs = [float(k * half_pi) for k in range(2**20 + 1)]
     xs = [x for x in xs if x <= LIMIT]
     _check("every nearest k*pi/2, k <= 2^20", xs)
     rng = np.random.default_rng(6)
