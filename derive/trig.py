@@ -7,7 +7,10 @@ stops LLVM from vectorising the rest of it. ``SINCOS_SOURCE`` is the text of a
 expressions (which LLVM turns into selects), so the whole loop stays SIMD. The same text
 runs as plain Python (single-scene path, no numba) with bit-identical results: IEEE
 double arithmetic in the same order, no fused multiply-add (numba has no ``math.fma``
-and does not contract by default).
+and does not contract by default; never compile it with ``fastmath``). In numba code,
+compile it with ``numba.njit(inline="always")`` in the same file as its loops: called as
+a separate njit function it is not inlined and the calling ``prange`` loop is not
+vectorised (measured: 0 packed instructions, against 75 inlined).
 
 Method (the medium-size path of fdlibm's ``__ieee754_rem_pio2`` and the kernels
 ``__kernel_sin``/``__kernel_cos``, made branch-free):

@@ -210,7 +210,7 @@ def test_source_is_deterministic_and_exactly_the_derived_constants():
 def test_every_multiple_of_half_pi_up_to_the_limit():
     """The nearest double to k·π/2 for every k in [0, 2^20] (the worst cancellations of
     the reduction in the domain; negative k follow by the symmetry test), and 2e5
-    uniform arguments. ~1 min."""
+    uniform arguments. About 5 min on the busy shared 2-core machine."""
     import mpmath
 
     with mpmath.workdps(40):
