@@ -32,14 +32,12 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Optional, Union
 
+from ._util import require
 from .result import UNIT_LABELS
 from .scene import CRITICAL, Scene, SceneError, load_scene
 from .single import solve
 
-__all__ = ["explore", "Explorer", "INSTALL_HINT", "MU_RANGE_FACTOR"]
-
-INSTALL_HINT = ("impactsym.explore needs ipywidgets and matplotlib: pip install 'impactsym[explore]' "
-                "(or pip install ipywidgets matplotlib)")
+__all__ = ["explore", "Explorer", "MU_RANGE_FACTOR"]
 
 #: μ's slider reaches this multiple of μ_c (beyond μ_c the result is flagged).
 MU_RANGE_FACTOR = 1.5
@@ -70,12 +68,11 @@ class Explorer:
     """
 
     def __init__(self, scene: Union[Scene, Mapping, str, Path], *, figsize=(8.5, 5.2), dpi: int = 80):
-        try:
-            import ipywidgets as widgets
-            from matplotlib.backends.backend_agg import FigureCanvasAgg
-            from matplotlib.figure import Figure
-        except ImportError:
-            raise ImportError(INSTALL_HINT) from None
+        widgets = require("ipywidgets", extra="explore", what="impactsym.explore")
+        require("matplotlib", extra="explore", what="impactsym.explore", load=False)
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
         from . import plot
 
         self._plot = plot

@@ -15,7 +15,7 @@ import pandas as pd
 import pytest
 
 import impactsym
-from impactsym import dask_engine
+from impactsym import batch, dask_engine
 
 distributed = pytest.importorskip("distributed")
 
@@ -90,7 +90,7 @@ def test_solve_batch_on_the_cluster_equals_local(client):
     columns = _columns(1000)
     local = impactsym.solve_batch(columns)
     via_engine = impactsym.solve_batch(columns, engine="dask")
-    chunked = dask_engine.solve_batch_dask(columns, chunk_size=130)
+    chunked = batch.solve_batch_dask(columns, chunk_size=130)
     for result in (via_engine, chunked):
         assert list(result) == list(local)
         for name, column in local.items():
@@ -104,13 +104,13 @@ def test_solve_batch_of_a_dataframe_keeps_its_index(client):
     frame = pd.DataFrame({k: np.broadcast_to(v, (300,)) for k, v in columns.items()},
                          index=pd.Index(np.arange(300) * 3 + 1000, name="case"))
     local = impactsym.solve_batch(frame, outputs="impulses")
-    assert_same(dask_engine.solve_batch_dask(frame, outputs="impulses", chunk_size=64), local)
+    assert_same(batch.solve_batch_dask(frame, outputs="impulses", chunk_size=64), local)
     assert_same(impactsym.solve_batch(frame, outputs="impulses", engine="dask"), local)
 
 
 def test_solve_batch_with_unequal_columns_raises_one_line():
     with pytest.raises(ValueError, match=r"^e: length 3 differs from the other columns \(2\)$"):
-        dask_engine.solve_batch_dask({"m1": np.ones(2), "e": np.ones(3)})
+        batch.solve_batch_dask({"m1": np.ones(2), "e": np.ones(3)})
 
 
 def test_without_dask_the_error_names_the_extra(monkeypatch):
