@@ -318,7 +318,7 @@ def set_errors(outs: dict, scene_set, energy_floor: float = 1e-10) -> SetErrors:
     """Natural-scale errors of ``outs`` (arrays by output name) against the set's references."""
     from mpmath import mp
 
-    from tests import reference as R
+    from impactsym.testing import reference as R
 
     n = scene_set.n
     row = np.empty(n)

@@ -647,7 +647,7 @@ def run_sweep(points: int) -> dict:
         code = os.waitstatus_to_exitcode(status)
         size = out.stat().st_size if out.exists() else 0
     shown = ["impactsym"] + cmd[1:]
-    shown[shown.index("-o") + 1] = "/tmp/…/sweep.parquet"
+    shown[shown.index("-o") + 1] = "TMPDIR/sweep.parquet"
     return {"command": " ".join(shown),
             "rows": k * k, "wall_s": wall, "rows_per_s": k * k / wall, "exit_code": code,
             "peak_rss_gb": usage.ru_maxrss / 2**20, "file_gb": size / 1e9,

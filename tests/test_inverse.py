@@ -9,7 +9,7 @@ import pytest
 
 import impactsym
 from impactsym.cli import main
-from tests import scenes
+from impactsym.testing import scenes
 
 FWD_IN = ("v1x", "v1y", "w1", "v2x", "v2y", "w2")
 FWD_OUT = ("V1x", "V1y", "W1", "V2x", "V2y", "W2")

@@ -15,7 +15,7 @@ from impactsym.cli import main
 from impactsym.scene import SceneError, load_scene
 from generated.presets import PRESETS
 
-from .scenes import random_realistic
+from impactsym.testing.scenes import random_realistic
 
 ROOT = Path(__file__).resolve().parents[1]
 TWO_CAR = json.loads((ROOT / "examples" / "two_car_us.json").read_text())

@@ -9,7 +9,7 @@ import pytest
 
 import impactsym
 from impactsym.cli import main
-from tests import scenes
+from impactsym.testing import scenes
 
 
 def _forward_then_columns(n=300, seed=21):

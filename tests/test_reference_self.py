@@ -13,12 +13,8 @@ import numpy as np
 import pytest
 from mpmath import mp
 
-try:
-    from . import reference as R
-    from . import scenes
-except ImportError:  # tests/ is not a package: pytest puts it on sys.path
-    import reference as R
-    import scenes
+from impactsym.testing import reference as R
+from impactsym.testing import scenes
 
 TIGHT = mp.mpf("1e-40")
 

@@ -37,12 +37,8 @@ from mpmath import mp
 
 import impactsym
 
-try:
-    from . import reference as R
-    from . import scenes
-except ImportError:  # tests/ is not a package: pytest puts it on sys.path
-    import reference as R
-    import scenes
+from impactsym.testing import reference as R
+from impactsym.testing import scenes
 
 TOL = 1e-12
 """Largest accepted error of every output, relative to its natural scale."""

@@ -1,11 +1,13 @@
 """Independent 50-digit reference solver for the planar impact equations.
 
-This module shares no algebra with the package's closed forms: it writes the six
-equations of ``/work/shared/conventions.md`` as one linear system in the unknowns
+Test support, not runtime code: ``import impactsym`` never imports it, it needs
+mpmath (the ``test`` extra), and it never imports ``derive`` or ``generated``.
+It shares no algebra with the package's closed forms: it writes the six
+impact equations (the frame and signs below) as one linear system in the unknowns
 ``(V1x, V1y, W1, V2x, V2y, W2, Px, Py, M)`` and solves it numerically with
 ``mpmath.lu_solve`` at 50 significant digits.
 
-Conventions (the contract in conventions.md):
+Conventions:
 
 * scene frame (x, y); ``n = (cos gamma, sin gamma)`` points from vehicle 1 toward
   vehicle 2, ``t = (-sin gamma, cos gamma)``; the vehicles approach when
