@@ -53,7 +53,7 @@ class _Base:
     fixed: dict
 
     @classmethod
-    def load(cls, scene) -> "_Base":
+    def load(cls, scene) -> _Base:
         scene = load_scene(scene)
         _, critical, values = scene.to_inputs()
         _, fixed = _kernels.preset(scene.model)
@@ -157,7 +157,7 @@ class GridPlan:
     axes: tuple
 
     @classmethod
-    def build(cls, scene, values: Mapping, outputs) -> "GridPlan":
+    def build(cls, scene, values: Mapping, outputs) -> GridPlan:
         """Check names and values against the base scene; see `sweep`."""
         require("pandas", extra="sweep", what="sweep")
         check_outputs(outputs)
@@ -223,7 +223,7 @@ class SamplePlan:
     rows: int
 
     @classmethod
-    def build(cls, scene, dists: Mapping, n, seed, outputs) -> "SamplePlan":
+    def build(cls, scene, dists: Mapping, n, seed, outputs) -> SamplePlan:
         """Check names, distributions, ``n`` and ``seed``; see `sample`."""
         require("pandas", extra="sweep", what="sample")
         if not is_integer(n) or n < 1:

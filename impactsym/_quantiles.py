@@ -146,7 +146,7 @@ class OrderStatistics:
 
     def __init__(self, path: Path):
         self.path, self.count = path, 0
-        self._file = open(path, "wb")
+        self._file = open(path, "wb")  # noqa: SIM115 (appended to by add, closed by close/select)
 
     def add(self, values: np.ndarray) -> None:
         np.ascontiguousarray(values, dtype=np.float64).tofile(self._file)
@@ -168,7 +168,7 @@ class OrderStatistics:
             small = {(p, b) for p, b, _k, size in open_.values() if size <= self.SORT_BUDGET}
             large = {(p, b) for p, b, _k, size in open_.values() if size > self.SORT_BUDGET}
             kept, counts = self._pass(small, large)
-            for rank, (prefix, bits, k, size) in list(open_.items()):
+            for rank, (prefix, bits, k, _size) in list(open_.items()):
                 if (prefix, bits) in kept:
                     found[rank] = _value(int(kept[(prefix, bits)][k]))
                     del open_[rank]

@@ -30,7 +30,8 @@ class _FileSink:
     removed again by `abort`."""
 
     def __init__(self, path: Path, mode: str, **options):
-        self.path, self._file = path, open(path, mode, **options)
+        # open now, so an unwritable path fails before any work; closed by close/abort
+        self.path, self._file = path, open(path, mode, **options)  # noqa: SIM115
 
     def close(self) -> None:
         self._file.close()

@@ -156,7 +156,7 @@ def _row_models(columns, model):
         uniq = set(model.tolist())
         if len(uniq) == 1:
             model = uniq.pop()
-    mu = columns["mu"] if "mu" in columns else None
+    mu = columns.get("mu")
     if isinstance(mu, str):
         if mu != CRITICAL:
             raise ValueError(f"mu: a number or {CRITICAL!r}, got {mu!r}")

@@ -30,7 +30,7 @@ import math
 import time
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Optional, Union
+from typing import Any
 
 from ._util import require
 from .result import UNIT_LABELS
@@ -45,7 +45,7 @@ MU_RANGE_FACTOR = 1.5
 _COEFFICIENTS = ("restitution", "impulse_ratio", "moment_restitution", "slip")
 
 
-def explore(scene: Union[Scene, Mapping, str, Path]) -> "Explorer":
+def explore(scene: Scene | Mapping | str | Path) -> Explorer:
     """Build the explorer of a forward scene (a Scene, a mapping or a file path).
 
     The returned :class:`Explorer` shows itself as the widget when it is a
@@ -67,7 +67,7 @@ class Explorer:
     ``timings`` the total of every update.
     """
 
-    def __init__(self, scene: Union[Scene, Mapping, str, Path], *, figsize=(8.5, 5.2), dpi: int = 80):
+    def __init__(self, scene: Scene | Mapping | str | Path, *, figsize=(8.5, 5.2), dpi: int = 80):
         widgets = require("ipywidgets", extra="explore", what="impactsym.explore")
         require("matplotlib", extra="explore", what="impactsym.explore", load=False)
         from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -90,7 +90,7 @@ class Explorer:
         self.fixed_critical = preset["fixed"].get("impulse_ratio") == CRITICAL
         impact = self.scene.impact
         self.result = None
-        self.error: Optional[str] = None
+        self.error: str | None = None
         self.last_timing = (0.0, 0.0)
         self.timings: list[float] = []
         self._busy = False
@@ -221,10 +221,7 @@ class Explorer:
             slider.description = "μ (μ_c = ?)"
             self.mu_note.value = "<small>μ_c unknown for this setting</small>"
             return
-        if critical:
-            mu = mu_c
-        else:
-            mu = slider.value
+        mu = mu_c if critical else slider.value
         lo, hi = mu_range(mu_c, mu)
         _set_range(slider, lo, hi)
         if critical:

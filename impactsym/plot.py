@@ -56,7 +56,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Optional, Union
+from typing import Any
 
 from ._util import require
 from .codes import FLAG_ENERGY_CREATED, FLAG_MU_BEYOND_CRITICAL, FLAG_TENSILE_IMPULSE
@@ -90,7 +90,7 @@ _FLAG_SHORT = {
     FLAG_MU_BEYOND_CRITICAL: "μ not between 0 and μ_c",
 }
 
-SceneLike = Union[Scene, Mapping, str, Path]
+SceneLike = Scene | Mapping | str | Path
 
 
 @dataclass
@@ -100,21 +100,21 @@ class _Body:
     name: str
     fixed: bool
     cg: tuple[float, float]
-    outline: Optional[tuple[float, float, float]] = None  # length, width, heading [deg]
-    v0: Optional[tuple[float, float]] = None  # pre-impact velocity
-    v1: Optional[tuple[float, float]] = None  # post-impact velocity
-    dv: Optional[tuple[float, float]] = None  # delta-V
-    w0: Optional[float] = None  # pre-impact yaw rate
-    w1: Optional[float] = None  # post-impact yaw rate
-    force: Optional[tuple[float, float]] = None  # direction of the impulse on the body (unit)
-    heading: Optional[float] = None  # the scene's ``heading`` [deg], for the PDOF label
+    outline: tuple[float, float, float] | None = None  # length, width, heading [deg]
+    v0: tuple[float, float] | None = None  # pre-impact velocity
+    v1: tuple[float, float] | None = None  # post-impact velocity
+    dv: tuple[float, float] | None = None  # delta-V
+    w0: float | None = None  # pre-impact yaw rate
+    w1: float | None = None  # post-impact yaw rate
+    force: tuple[float, float] | None = None  # direction of the impulse on the body (unit)
+    heading: float | None = None  # the scene's ``heading`` [deg], for the PDOF label
 
 
 # --------------------------------------------------------------------------- public
 
 
-def scene(scene_or_result: Any, ax=None, *, scene: Optional[SceneLike] = None, result: Any = None,
-          velocity_scale: Optional[float] = None, legend: bool = True, title: Optional[str] = None):
+def scene(scene_or_result: Any, ax=None, *, scene: SceneLike | None = None, result: Any = None,
+          velocity_scale: float | None = None, legend: bool = True, title: str | None = None):
     """Draw a scene, or a solved scene, on ``ax`` (a new figure when ``None``).
 
     ``scene_or_result`` is a scene (a :class:`~impactsym.scene.Scene`, a
@@ -136,7 +136,7 @@ def scene(scene_or_result: Any, ax=None, *, scene: Optional[SceneLike] = None, r
     return ax
 
 
-def save_plot(scene_or_result: Any, path: Union[str, Path], *, scene: Optional[SceneLike] = None,
+def save_plot(scene_or_result: Any, path: str | Path, *, scene: SceneLike | None = None,
               result: Any = None, dpi: int = 120, **options) -> Path:
     """Draw like :func:`scene` and write the figure to ``path``.
 
@@ -175,7 +175,7 @@ def add_plot_argument(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def default_velocity_scale(scene_or_result: Any, *, scene: Optional[SceneLike] = None,
+def default_velocity_scale(scene_or_result: Any, *, scene: SceneLike | None = None,
                            result: Any = None) -> float:
     """The ``velocity_scale`` :func:`scene` would choose: the drawn length (scene
     length unit) of one velocity unit, so that the longest arrow is about twice
@@ -208,7 +208,7 @@ def _is_scene_like(obj: Any) -> bool:
     return isinstance(obj, (Scene, Mapping, str, Path))
 
 
-def _resolve(obj: Any, scene: Optional[SceneLike], result: Any) -> tuple[Scene, Any, tuple[float, float]]:
+def _resolve(obj: Any, scene: SceneLike | None, result: Any) -> tuple[Scene, Any, tuple[float, float]]:
     """The scene, the result (or ``None``) and the impact-centre position."""
     if _is_scene_like(obj):
         if scene is not None:
@@ -275,7 +275,7 @@ def _raw_position(raw: Any):
     return None
 
 
-def _vec(value: Any) -> Optional[tuple[float, float]]:
+def _vec(value: Any) -> tuple[float, float] | None:
     if value is None:
         return None
     try:
@@ -285,7 +285,7 @@ def _vec(value: Any) -> Optional[tuple[float, float]]:
     return (x, y) if math.isfinite(x) and math.isfinite(y) else None
 
 
-def _num(value: Any) -> Optional[float]:
+def _num(value: Any) -> float | None:
     try:
         number = float(value)
     except (TypeError, ValueError):
@@ -326,7 +326,7 @@ def _frame(scene: Scene):
     return n, t
 
 
-def _outline(vehicle, velocity) -> Optional[tuple[float, float, float]]:
+def _outline(vehicle, velocity) -> tuple[float, float, float] | None:
     """(length, width, heading) when the scene entry gives length and width."""
     length, width = _num(vehicle.extra.get("length")), _num(vehicle.extra.get("width"))
     if length is None or width is None:
@@ -490,7 +490,7 @@ def _rotated(centre, heading_deg, local):
     return [(centre[0] + c * x - s * y, centre[1] + s * x + c * y) for x, y in local]
 
 
-def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, title: Optional[str]):
+def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, title: str | None):
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
@@ -635,8 +635,8 @@ def _legend(ax, handles, title: str):
                      title=title, title_fontsize=8, frameon=False)
 
 
-def _render(ax, scene_or_result: Any, *, scene: Optional[SceneLike] = None,
-            velocity_scale: Optional[float] = None, title: Optional[str] = None):
+def _render(ax, scene_or_result: Any, *, scene: SceneLike | None = None,
+            velocity_scale: float | None = None, title: str | None = None):
     """Draw like :func:`scene` but without the legend; return ``(handles, legend title)``
     for :func:`_legend` (the explorer adds the legend only when it changes)."""
     the_scene, the_result, position = _resolve(scene_or_result, scene, None)

@@ -13,7 +13,6 @@ impulse, μ beyond μ_c) hatched grey, rows not solved dark grey and the line
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Optional, Union
 
 import numpy as np
 
@@ -62,7 +61,7 @@ _MASK_STYLE = {
 }
 
 
-def sweep(df, x: str, y: Optional[str] = None, color=None, ax=None, units: Optional[str] = None):
+def sweep(df, x: str, y: str | None = None, color=None, ax=None, units: str | None = None):
     """Draw a parameter sweep on ``ax`` (a new pyplot figure when ``None``); return the axes.
 
     ``df`` is a sweep frame (a pandas DataFrame, or a mapping of equal-length
@@ -109,8 +108,8 @@ def sweep(df, x: str, y: Optional[str] = None, color=None, ax=None, units: Optio
     return ax
 
 
-def save_sweep(df, path: Union[str, Path], x: str, y: Optional[str] = None, color=None,
-               units: Optional[str] = None) -> Path:
+def save_sweep(df, path: str | Path, x: str, y: str | None = None, color=None,
+               units: str | None = None) -> Path:
     """Draw like :func:`sweep` on a fresh Agg figure (no pyplot, no display
     needed) and write it to ``path`` (PNG for ``.png``; the format follows the
     suffix as in :func:`save_plot`). Returns the path."""
@@ -135,7 +134,7 @@ def _color_columns(color, two_d: bool) -> list[str]:
     return columns
 
 
-def _check_sweep(df, x: str, y: Optional[str], columns: list[str], units: Optional[str]) -> None:
+def _check_sweep(df, x: str, y: str | None, columns: list[str], units: str | None) -> None:
     """Unknown columns or units, a parameter varied but not drawn: ValueError (one line)."""
     if units is not None and units not in _SYSTEM_UNITS:
         raise ValueError(f"units: expected 'SI' or 'US', got {units!r}")
@@ -159,20 +158,20 @@ def _parameters(names: list[str]) -> list[str]:
     return names[:first]
 
 
-def _unit(name: str, units: Optional[str]) -> Optional[str]:
+def _unit(name: str, units: str | None) -> str | None:
     """The unit of a column in ``units`` ("SI", "US" or None: only the units
     both systems share); None for a pure number or an unknown column."""
     key = _QUANTITIES.get(name, (name, None))[1]
     return _FIXED_UNITS.get(key) or (_SYSTEM_UNITS[units].get(key) if units and key else None)
 
 
-def _label(name: str, units: Optional[str]) -> str:
+def _label(name: str, units: str | None) -> str:
     """``"energy loss TL [J]"``: the quantity's name, and its unit when known."""
     text, unit = _QUANTITIES.get(name, (name, None))[0], _unit(name, units)
     return f"{text} [{unit}]" if unit else text
 
 
-def _lines_label(columns: list[str], units: Optional[str]) -> str:
+def _lines_label(columns: list[str], units: str | None) -> str:
     """The y label of a line plot: one column's label, or the names with their
     common unit (``"dV1, dV2 [m/s]"``)."""
     if len(columns) == 1:
@@ -269,7 +268,7 @@ def _mu_c_line(ax, mu_c: np.ndarray, x: str, xs, ys, xedges, yedges):
     return line
 
 
-def _sweep_map(ax, df, x: str, y: str, column: str, units: Optional[str]) -> None:
+def _sweep_map(ax, df, x: str, y: str, column: str, units: str | None) -> None:
     """The 2-D heatmap of :func:`sweep`."""
     from matplotlib.patches import Patch
 
@@ -294,7 +293,7 @@ def _sweep_map(ax, df, x: str, y: str, column: str, units: Optional[str]) -> Non
     _finish(ax, _label(x, units), _label(y, units), _label(column, units), solved, impossible, handles)
 
 
-def _sweep_line(ax, df, x: str, columns: list[str], units: Optional[str]) -> None:
+def _sweep_line(ax, df, x: str, columns: list[str], units: str | None) -> None:
     """The 1-D line plot of :func:`sweep`."""
     xs, index = _axis_values(df, x)
     if len(xs) != len(index):

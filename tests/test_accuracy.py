@@ -13,7 +13,6 @@ import pytest
 from mpmath import mp
 
 import impactsym
-
 from impactsym.testing import reference as R
 from impactsym.testing import scenes
 

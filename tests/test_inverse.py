@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -102,7 +103,7 @@ def test_cli_invert_prints_the_documented_object(capsys):
 
 
 def test_cli_invert_with_zero_restitution_exits_2_naming_what_is_missing(tmp_path, capsys):
-    scene = json.loads(open("examples/invert_two_car_si.json").read())
+    scene = json.loads(Path("examples/invert_two_car_si.json").read_text())
     scene["impact"]["restitution"] = 0.0
     path = tmp_path / "e0.json"
     path.write_text(json.dumps(scene))
@@ -112,7 +113,7 @@ def test_cli_invert_with_zero_restitution_exits_2_naming_what_is_missing(tmp_pat
 
 
 def test_cli_invert_refuses_a_critical_impulse_ratio(tmp_path, capsys):
-    scene = json.loads(open("examples/invert_two_car_si.json").read())
+    scene = json.loads(Path("examples/invert_two_car_si.json").read_text())
     scene["impact"]["impulse_ratio"] = "critical"
     path = tmp_path / "crit.json"
     path.write_text(json.dumps(scene))

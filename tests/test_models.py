@@ -11,10 +11,9 @@ import pytest
 
 import impactsym
 from derive import presets as derive_presets
+from generated.presets import PRESETS
 from impactsym.cli import main
 from impactsym.scene import SceneError, load_scene
-from generated.presets import PRESETS
-
 from impactsym.testing.scenes import random_realistic
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -15,7 +15,6 @@ import pytest
 
 import impactsym
 from impactsym import _kernels
-
 from impactsym.testing import reference as R
 from impactsym.testing import scenes
 

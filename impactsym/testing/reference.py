@@ -37,10 +37,9 @@ from mpmath import mp
 DPS = 50
 """Working precision of the reference, in decimal digits."""
 
-RIGID_INPUTS = ("m1 m2 I1 I2 v1x v1y w1 v2x v2y w2 "
-                "r1x r1y r2x r2y gamma e mu e_m").split()
-PARTICLE_INPUTS = "m1 m2 v1x v1y v2x v2y gamma e mu".split()
-OUTPUTS = "V1x V1y W1 V2x V2y W2 Pn Pt M mu mu_c TL TLn TLt TLm".split()
+RIGID_INPUTS = ["m1", "m2", "I1", "I2", "v1x", "v1y", "w1", "v2x", "v2y", "w2", "r1x", "r1y", "r2x", "r2y", "gamma", "e", "mu", "e_m"]
+PARTICLE_INPUTS = ["m1", "m2", "v1x", "v1y", "v2x", "v2y", "gamma", "e", "mu"]
+OUTPUTS = ["V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M", "mu", "mu_c", "TL", "TLn", "TLt", "TLm"]
 VELOCITY_KEYS = ("V1x", "V1y", "V2x", "V2y")
 YAW_KEYS = ("W1", "W2")
 ENERGY_KEYS = ("TL", "TLn", "TLt", "TLm")
