@@ -142,10 +142,10 @@ def _solved_frame(plan, shown: dict, varied: dict, start: int, stop: int):
 
 
 @dataclass(frozen=True)
-class GridPlan:
-    """A sweep: constants (kernel units, scalars) and axes, both as given
-    (``shown``) and in kernel units (``axes``). `frame` solves any range of
-    grid rows from its indices alone."""
+class _Plan:
+    """What every plan holds: the base scene's model and units, the requested
+    outputs, the constant inputs (kernel units, scalars), and the varied
+    inputs' names as the caller gave them and as kernel inputs."""
 
     model: str
     units: str
@@ -153,6 +153,13 @@ class GridPlan:
     constants: dict
     names: tuple
     kernels: tuple
+
+
+@dataclass(frozen=True)
+class GridPlan(_Plan):
+    """A sweep: the axes both as given (``shown``) and in kernel units
+    (``axes``). `frame` solves any range of grid rows from its indices alone."""
+
     shown: tuple
     axes: tuple
 
@@ -208,16 +215,10 @@ class GridPlan:
 
 
 @dataclass(frozen=True)
-class SamplePlan:
-    """A Monte Carlo sample: constants (kernel units) and the distributions of
-    the drawn inputs; `frame` draws and solves any range of rows."""
+class SamplePlan(_Plan):
+    """A Monte Carlo sample: the distributions of the drawn inputs; `frame`
+    draws and solves any range of rows."""
 
-    model: str
-    units: str
-    outputs: object
-    constants: dict
-    names: tuple
-    kernels: tuple
     dists: tuple
     entropy: int
     rows: int

@@ -228,8 +228,8 @@ def _progress_bar(rows: int, progress):
         if rows <= PROGRESS_ROWS or not sys.stderr.isatty():
             return None
         try:
-            from tqdm import tqdm
-        except ImportError:
+            tqdm = require("tqdm", extra="sweep", what="a progress bar").tqdm
+        except ImportError:  # shown only when tqdm is there
             return None
     elif progress:
         tqdm = require("tqdm", extra="sweep", what="progress=True").tqdm
