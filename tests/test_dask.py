@@ -48,12 +48,14 @@ def client():
         yield c
 
 
+@pytest.mark.slow  # a two-process LocalCluster whose workers each load the kernels
 def test_sweep_on_the_cluster_equals_local(client):
     local = impactsym.sweep(US, **GRID)
     assert (local["status"] != 0).any() and (local["mu"] == "critical").any()
     assert_same(impactsym.sweep(US, **GRID, chunk_size=7, engine="dask"), local)
 
 
+@pytest.mark.slow  # a two-process LocalCluster whose workers each load the kernels
 def test_sample_on_the_cluster_equals_local_whatever_the_chunks(client):
     n = importlib.import_module("impactsym.sweep").BLOCK + 500
     local = impactsym.sample(SI, DISTS, n, seed=21, chunk_size=5000)
@@ -63,6 +65,7 @@ def test_sample_on_the_cluster_equals_local_whatever_the_chunks(client):
     assert dask.attrs["seed"] == 21
 
 
+@pytest.mark.slow  # a two-process LocalCluster whose workers each load the kernels
 def test_streaming_on_the_cluster_writes_the_local_rows_in_order(client, tmp_path):
     local = impactsym.sweep(US, **GRID)
     summary = impactsym.sweep(US, **GRID, chunk_size=5, engine="dask", out=tmp_path / "g.csv")
@@ -86,6 +89,7 @@ def _columns(n: int) -> dict:
     return columns
 
 
+@pytest.mark.slow  # a two-process LocalCluster whose workers each load the kernels
 def test_solve_batch_on_the_cluster_equals_local(client):
     columns = _columns(1000)
     local = impactsym.solve_batch(columns)
@@ -99,6 +103,7 @@ def test_solve_batch_on_the_cluster_equals_local(client):
     assert local["status"][7] != 0
 
 
+@pytest.mark.slow  # a two-process LocalCluster whose workers each load the kernels
 def test_solve_batch_of_a_dataframe_keeps_its_index(client):
     columns = _columns(300)
     frame = pd.DataFrame({k: np.broadcast_to(v, (300,)) for k, v in columns.items()},

@@ -39,6 +39,9 @@ import impactsym
 from impactsym.testing import reference as R
 from impactsym.testing import scenes
 
+# Minutes: thousands of hard rows checked against the 50-digit reference.
+pytestmark = pytest.mark.slow
+
 TOL = 1e-12
 """Largest accepted error of every output, relative to its natural scale."""
 TL_SELF_TOL = 1e-10
