@@ -21,6 +21,7 @@ def _run_derive(*args, cwd=ROOT):
                           capture_output=True, text=True, timeout=300)
 
 
+@pytest.mark.slow  # SymPy proves every claim: minutes
 @pytest.mark.parametrize("module", [particle, planar, delta_v, inverse, reconstruct, presets, crash3,
                                     report], ids=lambda m: m.__name__)
 def test_every_proof_passes(module):
@@ -28,6 +29,7 @@ def test_every_proof_passes(module):
     assert not failed, f"failed proofs: {failed}"
 
 
+@pytest.mark.slow  # SymPy re-proves the planar model
 def test_a_wrong_formula_fails_its_proof(monkeypatch):
     """The proofs are not vacuous: perturb the restitution formula and they fail."""
     good = planar._impulse_blocks
