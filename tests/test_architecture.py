@@ -52,7 +52,8 @@ def _imports(name: str, path: Path) -> set[str]:
             names = {f"{origin}.{alias.name}" for alias in node.names}
             found.update(names)
             ancestor = name == origin or name.startswith(origin + ".")
-            if not (ancestor and names <= set(MODULES)):
+            # impactsym._generated is a module in an installed wheel only (pyproject force-include)
+            if not (ancestor and names <= set(MODULES) | set(GENERATED)):
                 found.add(origin)
     return found
 
