@@ -68,11 +68,13 @@ def _windowed(client, fn: Callable, shared, items: Iterator, scatter_items: bool
     """On a distributed client: a sliding window of futures, so the workers
     compute the next chunks while the caller consumes this one."""
     size = CHUNKS_PER_THREAD * max(1, sum(client.nthreads().values()))
-    # scatter([x])[0]: scatter splits a list, tuple or dict argument into many futures
-    common = client.scatter([shared], broadcast=True)[0]
+    # scatter([x])[0]: scatter splits a list, tuple or dict argument into many futures.
+    # hash=False: a fresh key per call; with content-hashed keys a second call scattering
+    # the same value races the release of the first call's copy ("lost dependencies").
+    common = client.scatter([shared], broadcast=True, hash=False)[0]
     window = collections.deque()
     for item in items:
-        argument = client.scatter([item])[0] if scatter_items else item
+        argument = client.scatter([item], hash=False)[0] if scatter_items else item
         window.append(client.submit(fn, common, argument, pure=False))
         if len(window) >= size:
             yield window.popleft().result()
