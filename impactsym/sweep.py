@@ -26,6 +26,11 @@ units with ``gamma`` in radians, and the scene-file names ``normal_angle``
 
 Needs the ``sweep`` extra (pandas, pyarrow, tqdm); ``as_xarray`` the ``xarray``
 extra, ``engine="dask"`` the ``dask`` extra.
+
+This module is the API and runs the chunks; what a chunk computes is in
+`impactsym._plans`, the file writers in `impactsym._sinks`, the exact
+streaming percentiles in `impactsym._quantiles`, and the dask executor in
+`impactsym.dask_engine`.
 """
 
 from __future__ import annotations
