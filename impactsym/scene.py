@@ -39,7 +39,7 @@ if sys.version_info >= (3, 11):
 else:
     import tomli as tomllib
 
-from generated.presets import COEFFICIENT_INPUTS, PRESETS
+from ._kernels import COEFFICIENT_INPUTS, PRESETS
 
 from .casefile import (
     COEFFICIENT_KEYS,
