@@ -66,7 +66,24 @@ def comparison(datasets, key):
     return found[0]
 
 
-@pytest.mark.parametrize("key", sorted(BOUNDS), ids=lambda k: " | ".join(k))
+# Bounds chosen before looking that the first run MISSED: kept as chosen, run as
+# strict xfails (the test fails if the miss ever disappears), and reported in
+# docs/validation.md. Our crush energies reproduce Woolley's 1985 CRASH3 energies
+# within 1-4 % in the five tests with small PDOFs (3, 4, 5, 11, 12) but exceed them
+# by 33-207 % in the oblique and side tests: Woolley's side inputs differ from the
+# category defaults Neades published (even uncorrected, test 1 gives 67 000 ft·lb
+# against his 48 392), and the capped correction doubles the side energies.
+MISSED = {("ricsac", "CRASH3 (published profiles)", "energy loss", "woolley_1985"):
+          "first run: median 32.5 %, worst 207 % (bound 20 %): Woolley's 1985 side-impact "
+          "inputs differ from the published defaults"}
+
+
+def _cases():
+    return [pytest.param(key, marks=pytest.mark.xfail(strict=True, reason=MISSED[key]))
+            if key in MISSED else key for key in sorted(BOUNDS)]
+
+
+@pytest.mark.parametrize("key", _cases(), ids=lambda k: " | ".join(k))
 def test_errors_within_the_bounds_chosen_before_looking(datasets, key):
     stats = comparison(datasets, key).stats()
     median, worst = BOUNDS[key]
