@@ -342,6 +342,27 @@ def _summary_json(summary, plan) -> dict:
     }
 
 
+def _add_validate(parser: argparse.ArgumentParser) -> None:
+    """Arguments of ``validate``: ``--markdown`` and ``--plots DIR``."""
+    parser.add_argument("--markdown", action="store_true",
+                        help="print the whole report (statistics, per-row tables) as markdown")
+    parser.add_argument("--plots", metavar="DIR", default=None,
+                        help="save the predicted-versus-measured plots (PNG) in DIR (needs matplotlib)")
+
+
+def _run_validate(args: argparse.Namespace) -> int:
+    """The models against RICSAC, IIHS and NHTSA crash tests (impactsym/validation.py)."""
+    from . import validation
+
+    datasets = validation.report()
+    figures = None
+    if args.plots:
+        paths = validation.plot(datasets, args.plots)
+        figures = {ds.name: str(path) for ds, path in zip(datasets, paths)}
+    print(validation.markdown(datasets, figures) if args.markdown else validation.text_summary(datasets))
+    return 0
+
+
 COMMANDS: dict[str, Command] = {
     "solve": Command(
         "solve the impact of a scene (initial motion -> final motion, impulses, energy loss)",
@@ -378,6 +399,11 @@ COMMANDS: dict[str, Command] = {
         "Monte Carlo: draw inputs from distributions around a scene, print percentiles",
         _add_sample,
         _run_sample,
+    ),
+    "validate": Command(
+        "run the models against published crash tests (RICSAC, IIHS, NHTSA) and report the errors",
+        _add_validate,
+        _run_validate,
     ),
 }
 

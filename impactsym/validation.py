@@ -558,3 +558,177 @@ def _nhtsa() -> Dataset:
                  lambda r: r["dv"], lambda r: r["dv_measured"])]
     ds.notes.append(ASSUMPTIONS["nhtsa"])
     return ds
+
+
+# ---------------------------------------------------------------- output
+
+# Per dataset, the plots: (panel title, reference, [(model, quantity), ...]).
+PLOTS = {
+    "ricsac": [("delta-V [m/s] vs measured (Brach & Smith 2002)", "measured, Brach & Smith 2002",
+                [("CRASH3 (published profiles)", "delta-V"), ("CRASH3 (Neades' adjustments)", "delta-V"),
+                 ("rigid PIM (approx. impact centre)", "delta-V")]),
+               ("energy loss [ft lb] vs measured", None,
+                [("CRASH3 (published profiles)", "energy loss", "measured"),
+                 ("CRASH3 (Neades' adjustments)", "energy loss", "measured"),
+                 ("rigid PIM (approx. impact centre)", "energy loss", "measured_energy_loss")])],
+    "iihs": [("delta-V [ft/s] vs measured", "measured", [("rigid PIM (Brach's fits)", "delta-V")]),
+             ("yaw-rate change [deg/s] vs measured", "measured",
+              [("rigid PIM (Brach's fits)", "yaw-rate change")])],
+    "nhtsa": [("delta-V [mph]", None, [("rigid PIM", "delta-V", "published PIM"),
+                                        ("rigid PIM", "delta-V", "measured")]),
+              ("final yaw rate [deg/s] vs published PIM", "published PIM",
+               [("rigid PIM", "final yaw rate")]),
+              ("energy loss [ft lb] vs published PIM", "published PIM",
+               [("rigid PIM", "energy loss"), ("rigid PIM", "normal energy loss"),
+                ("rigid PIM", "tangential energy loss")])],
+}
+
+
+def _find(ds: Dataset, model: str, quantity: str, reference: str) -> Comparison:
+    return next(c for c in ds.comparisons
+                if (c.model, c.quantity, c.reference) == (model, quantity, reference))
+
+
+def plot(datasets: list[Dataset], directory: Path | str) -> list[Path]:
+    """Predicted-versus-measured plots with the 1:1 line, one PNG per dataset
+    saved in `directory` (needs matplotlib); returns the paths."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for ds in datasets:
+        panels = PLOTS[ds.name]
+        fig, axes = plt.subplots(1, len(panels), figsize=(5.2 * len(panels), 4.6), squeeze=False)
+        for ax, (title, reference, series) in zip(axes[0], panels):
+            top = 0.0
+            comps = [_find(ds, e[0], e[1], e[2] if len(e) > 2 else reference) for e in series]
+            mixed_q = len({c.quantity for c in comps}) > 1
+            mixed_r = len({c.reference for c in comps}) > 1
+            for comp in comps:
+                xs, ys = [r for _, _, r in comp.rows], [m for _, m, _ in comp.rows]
+                label = comp.model + (f", {comp.quantity}" if mixed_q else "") \
+                    + (f" vs {comp.reference}" if mixed_r else "")
+                ax.scatter(xs, ys, s=22, alpha=0.8,
+                           label=f"{label} (median |err| {comp.stats()['median']:.1f} %)")
+                top = max(top, *xs, *ys)
+            ax.ticklabel_format(style="sci", scilimits=(-3, 4))
+            ax.plot([0, top * 1.05], [0, top * 1.05], "k--", lw=1, label="1:1")
+            ax.set_xlabel("reference")
+            ax.set_ylabel("model")
+            ax.set_title(title, fontsize=10)
+            ax.legend(fontsize=7)
+            ax.set_aspect("equal", adjustable="box")
+        fig.suptitle(ds.title, fontsize=11)
+        fig.tight_layout()
+        path = directory / f"{ds.name}.png"
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        paths.append(path)
+    return paths
+
+
+def _fmt(value: Any, digits: int = 2) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "yes" if value else ""
+    if isinstance(value, float):
+        if math.isnan(value):
+            return "n/a"
+        return f"{value:,.0f}" if abs(value) >= 1000 else f"{value:.{digits}f}"
+    return str(value)
+
+
+def _table(rows: list[dict], columns: list[tuple[str, str]]) -> list[str]:
+    """A markdown table of `rows` with (header, key) columns."""
+    lines = ["| " + " | ".join(h for h, _ in columns) + " |", "|" + "---|" * len(columns)]
+    lines += ["| " + " | ".join(_fmt(r.get(k)) for _, k in columns) + " |" for r in rows]
+    return lines
+
+
+STATS_COLUMNS = [("model", "model"), ("quantity", "quantity"), ("reference", "reference"),
+                 ("n", "n"), ("median abs err %", "median"), ("worst abs err %", "worst"),
+                 ("median signed err %", "bias")]
+
+
+def statistics_rows(datasets: list[Dataset]) -> list[dict[str, Any]]:
+    """One row per comparison: dataset, model, quantity, reference and its statistics."""
+    return [{"dataset": ds.name, "model": c.model, "quantity": c.quantity,
+             "reference": c.reference, **c.stats()} for ds in datasets for c in ds.comparisons]
+
+
+def _detail(ds: Dataset) -> list[str]:
+    """The dataset's per-row tables as markdown."""
+    t = ds.tables
+    if ds.name == "ricsac":
+        merged = [{**p, "dv_neades": a["dv"], "dv_eff_neades": a["dv_eff"], "alpha_neades": a["alpha"],
+                   "gamma_neades": a["gamma"], "dv_nogamma": g["dv"]}
+                  for p, a, g in zip(t["crash3 published"], t["crash3 neades"], t["crash3 neades, gamma = 1"])]
+        pim = [{"test": r["test"], **{f"{k}": r.get(k) for k in
+                ("dv1", "dv1 Brach & Smith 2002", "dv2", "dv2 Brach & Smith 2002", "energy_loss",
+                 "brach_energy_loss", "measured_energy_loss", "mu_c", "brach_mu", "sensitivity_pct",
+                 "status")}} for r in t["pim"]]
+        return (["", "CRASH3 delta-V per vehicle [m/s] (CG delta-V; 'eff' = effective-mass delta-V):", ""]
+                + _table(merged, [("veh", "vehicle"), ("face", "face"), ("alpha pub", "alpha"),
+                                  ("capped", "capped"), ("gamma", "gamma"), ("dV pub", "dv"),
+                                  ("alpha Neades", "alpha_neades"), ("dV Neades", "dv_neades"),
+                                  ("dV eff Neades", "dv_eff_neades"), ("dV Neades gamma=1", "dv_nogamma"),
+                                  ("meas untransf.", "untransformed"), ("meas B&S 2002", "Brach & Smith 2002"),
+                                  ("meas McHenry", "McHenry 1997"), ("Neades raw CRASH", "neades_raw_crash")])
+                + ["", "Energy loss per test [ft lb]:", ""]
+                + _table(t["energy"], [("test", "test"), ("CRASH3 pub", "published"),
+                                       ("CRASH3 pub, Woolley corr.", "published, woolley"),
+                                       ("CRASH3 Neades", "neades"), ("Woolley 1985 CRASH3", "woolley_1985"),
+                                       ("Brach PIM", "brach_pim"), ("measured", "measured"),
+                                       ("initial KE", "initial")])
+                + ["", "Rigid PIM with the approximated impact centre (delta-V m/s, energy ft lb; "
+                   "sensitivity = largest delta-V change % for a 0.2 m shift of either centre):", ""]
+                + _table(pim, [("test", "test"), ("dV1", "dv1"), ("meas 1", "dv1 Brach & Smith 2002"),
+                               ("dV2", "dv2"), ("meas 2", "dv2 Brach & Smith 2002"),
+                               ("TL", "energy_loss"), ("Brach TL", "brach_energy_loss"),
+                               ("measured TL", "measured_energy_loss"), ("mu_c", "mu_c"),
+                               ("Brach mu", "brach_mu"), ("sens. %", "sensitivity_pct")])
+                + ["", "Momentum balance of Vossou's measured separation velocities "
+                   "(change of total momentum, % of the initial):", ""]
+                + _table(t["momentum"], [("test", "test"), ("x %", "x_pct"), ("y %", "y_pct")]))
+    if ds.name == "iihs":
+        return ["", "Per test (ft/s, deg/s):", ""] + _table(
+            t["barrier"], [("test", "test"), ("vehicle", "vehicle"), ("kind", "kind"),
+                           ("dV", "dv"), ("dV meas", "dv_measured"), ("dVx", "dvx"),
+                           ("dVx meas", "dvx_measured"), ("dVy", "dvy"), ("dVy meas", "dvy_measured"),
+                           ("yaw", "yaw"), ("yaw meas", "yaw_measured")])
+    return ["", "Per vehicle (energies ft lb per test, delta-V mph, yaw deg/s):", ""] + _table(
+        t["nhtsa"], [("test", "test"), ("vehicle", "vehicle"), ("TL", "energy_loss"),
+                     ("TL pub", "energy_loss_published"), ("TLn", "normal_loss"),
+                     ("TLn pub", "normal_loss_published"), ("TLt", "tangential_loss"),
+                     ("TLt pub", "tangential_loss_published"), ("dV", "dv"), ("dV pub", "dv_published"),
+                     ("dV meas", "dv_measured"), ("yaw", "yaw"), ("yaw pub", "yaw_published")])
+
+
+def markdown(datasets: list[Dataset], figures: Mapping[str, str] | None = None) -> str:
+    """The report as markdown: per dataset the assumptions, the error
+    statistics by model, the per-row tables and (optionally) the figure."""
+    lines = ["Generated by `impactsym validate --markdown` (impactsym/validation.py). "
+             "Errors: 100 (model - reference) / reference."]
+    for ds in datasets:
+        lines += ["", f"### {ds.title}", ""] + [f"- {note}" for note in ds.notes]
+        lines += ["", "Error statistics:", ""]
+        lines += _table([{"model": c.model, "quantity": c.quantity, "reference": c.reference,
+                          **c.stats()} for c in ds.comparisons], STATS_COLUMNS)
+        if figures and ds.name in figures:
+            lines += ["", f"![{ds.title}]({figures[ds.name]})"]
+        lines += _detail(ds)
+    return "\n".join(lines) + "\n"
+
+
+def text_summary(datasets: list[Dataset]) -> str:
+    """The error statistics as a plain-text table for a terminal."""
+    rows = statistics_rows(datasets)
+    head = f"{'dataset':8} {'model':36} {'quantity':22} {'reference':30} {'n':>3} {'median%':>8} {'worst%':>8} {'bias%':>8}"
+    body = [f"{r['dataset']:8} {r['model'][:36]:36} {r['quantity'][:22]:22} {r['reference'][:30]:30} "
+            f"{r['n']:3d} {r['median']:8.1f} {r['worst']:8.1f} {r['bias']:8.1f}" for r in rows]
+    return "\n".join([head, *body])
