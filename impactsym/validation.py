@@ -36,6 +36,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
+from .codes import describe_flags
 from .crash3 import crash3
 from .scene import SceneError
 from .single import solve
@@ -352,6 +353,7 @@ def ricsac_pim() -> list[dict[str, Any]]:
                "mu_c": base.mu_c, "brach_mu": _num(row["brach1987_mu"]),
                "energy_loss": base.TL / FT_LB, "brach_energy_loss": _num(row["brach1987_energy_loss_ftlb"]),
                "measured_energy_loss": _num(row["energy_loss_measured_ftlb"]),
+               "brach_tangential": _num(row["brach1987_tangential_loss_ftlb"]),
                "sensitivity_pct": spread}
         for i, vehicle in enumerate(base.vehicles, start=1):
             out[f"dv{i}"] = vehicle.delta_v_magnitude
@@ -510,12 +512,18 @@ def _ricsac() -> Dataset:
         ds.comparisons.append(_compare("ricsac", "rigid PIM (approx. impact centre)", "energy loss",
                                        ref, solved, test, lambda r: r["energy_loss"],
                                        lambda r, f=ref: r[f]))
+    ds.notes += [f"Rigid PIM, test {r['test']}: flagged: " + "; ".join(describe_flags(r["flags"]))
+                 + (f" (Brach's own tangential loss for this test is {_fmt(r['brach_tangential'])} "
+                    "ft lb, also negative)" if r["brach_tangential"] < 0 else "")
+                 for r in solved if r["flags"]]
     ds.tables["momentum"] = ricsac_momentum()
     worst = max(ds.tables["momentum"], key=lambda r: abs(r["x_pct"]))
     ds.notes += [ASSUMPTIONS["ricsac_crash3"], ASSUMPTIONS["ricsac_pim"],
                  f"Vossou's measured separation velocities do not conserve momentum (worst: test "
-                 f"{worst['test']}, {worst['x_pct']:+.1f} % of the initial momentum in x): the "
-                 "post-impact data are contaminated, so no model is fitted or judged on them.",
+                 f"{worst['test']}, {worst['x_pct']:+.1f} % of the initial momentum in x; test 1 "
+                 "to 10 between 1 and 17 %): the post-impact data are contaminated, so no model is "
+                 "fitted or judged on them. Test 12's pre-impact v1y (-4.28 m/s) also looks "
+                 "suspect (the y balance is off by 76 %); the rigid PIM uses it as published.",
                  IMPLAUSIBLE["7.2"]]
     return ds
 
