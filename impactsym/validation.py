@@ -147,7 +147,7 @@ def _num(text: str) -> float | None:
 
 def _wrap(angle: float) -> float:
     """An angle in degrees wrapped to (-180, 180]."""
-    return -((-angle + 180.0) % 360.0 - 180.0)
+    return -((-angle + 180.0) % 360.0 - 180.0) + 0.0  # + 0.0: no -0.0
 
 
 # ---------------------------------------------------------------- RICSAC: CRASH3
@@ -257,6 +257,10 @@ def ricsac_crash3(adjusted: bool, arm: bool = True) -> list[dict[str, Any]]:
 
 
 FT_LB = 4.4482216152605 * 0.3048   # J per ft·lb
+
+
+ENERGY_REFERENCES = {"measured": "measured", "brach_pim": "Brach's PIM (SAE 871993)",
+                     "woolley_1985": "Woolley's CRASH3 (1985)"}
 
 
 def ricsac_energy() -> list[dict[str, Any]]:
@@ -496,8 +500,8 @@ def _ricsac() -> Dataset:
     for label, key in (("CRASH3 (published profiles)", "published"),
                        ("CRASH3 (published, Woolley)", "published, woolley"),
                        ("CRASH3 (Neades' adjustments)", "neades")):
-        for ref in ("measured", "brach_pim", "woolley_1985"):
-            ds.comparisons.append(_compare("ricsac", label, "energy loss", ref, energy, test,
+        for ref, name in ENERGY_REFERENCES.items():
+            ds.comparisons.append(_compare("ricsac", label, "energy loss", name, energy, test,
                                            lambda r, k=key: r[k], lambda r, f=ref: r[f]))
     pim = ricsac_pim()
     ds.tables["pim"] = pim
@@ -508,9 +512,10 @@ def _ricsac() -> Dataset:
         ds.comparisons.append(Comparison("ricsac", "rigid PIM (approx. impact centre)", "delta-V",
                                          f"measured, {version}" if version in MEASURED_VERSIONS
                                          else "Brach's PIM 2002", tuple(pairs)))
-    for ref in ("measured_energy_loss", "brach_energy_loss"):
+    for ref, name in (("measured_energy_loss", "measured"),
+                      ("brach_energy_loss", ENERGY_REFERENCES["brach_pim"])):
         ds.comparisons.append(_compare("ricsac", "rigid PIM (approx. impact centre)", "energy loss",
-                                       ref, solved, test, lambda r: r["energy_loss"],
+                                       name, solved, test, lambda r: r["energy_loss"],
                                        lambda r, f=ref: r[f]))
     ds.notes += [f"Rigid PIM, test {r['test']}: flagged: " + "; ".join(describe_flags(r["flags"]))
                  + (f" (Brach's own tangential loss for this test is {_fmt(r['brach_tangential'])} "
@@ -578,7 +583,7 @@ PLOTS = {
                ("energy loss [ft lb] vs measured", None,
                 [("CRASH3 (published profiles)", "energy loss", "measured"),
                  ("CRASH3 (Neades' adjustments)", "energy loss", "measured"),
-                 ("rigid PIM (approx. impact centre)", "energy loss", "measured_energy_loss")])],
+                 ("rigid PIM (approx. impact centre)", "energy loss", "measured")])],
     "iihs": [("delta-V [ft/s] vs measured", "measured", [("rigid PIM (Brach's fits)", "delta-V")]),
              ("yaw-rate change [deg/s] vs measured", "measured",
               [("rigid PIM (Brach's fits)", "yaw-rate change")])],
@@ -682,8 +687,9 @@ def _detail(ds: Dataset) -> list[str]:
                  "status")}} for r in t["pim"]]
         return (["", "CRASH3 delta-V per vehicle [m/s] (CG delta-V; 'eff' = effective-mass delta-V):", ""]
                 + _table(merged, [("veh", "vehicle"), ("face", "face"), ("alpha pub", "alpha"),
-                                  ("capped", "capped"), ("gamma", "gamma"), ("dV pub", "dv"),
-                                  ("alpha Neades", "alpha_neades"), ("dV Neades", "dv_neades"),
+                                  ("capped", "capped"), ("gamma pub", "gamma"), ("dV pub", "dv"),
+                                  ("alpha Neades", "alpha_neades"), ("gamma Neades", "gamma_neades"),
+                                  ("dV Neades", "dv_neades"),
                                   ("dV eff Neades", "dv_eff_neades"), ("dV Neades gamma=1", "dv_nogamma"),
                                   ("meas untransf.", "untransformed"), ("meas B&S 2002", "Brach & Smith 2002"),
                                   ("meas McHenry", "McHenry 1997"), ("Neades raw CRASH", "neades_raw_crash")])

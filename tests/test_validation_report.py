@@ -47,9 +47,9 @@ BOUNDS = {
     ("ricsac", "CRASH3 (Neades' adjustments)", "delta-V", "measured, Brach & Smith 2002"): (25.0, None),
     ("ricsac", "CRASH3 (published profiles)", "delta-V", "measured, Brach & Smith 2002"): (35.0, None),
     ("ricsac", "CRASH3 (published profiles)", "delta-V", "Neades' raw CRASH"): (15.0, None),
-    ("ricsac", "CRASH3 (published profiles)", "energy loss", "woolley_1985"): (20.0, None),
+    ("ricsac", "CRASH3 (published profiles)", "energy loss", "Woolley's CRASH3 (1985)"): (20.0, None),
     ("ricsac", "rigid PIM (approx. impact centre)", "delta-V", "measured, Brach & Smith 2002"): (20.0, None),
-    ("ricsac", "rigid PIM (approx. impact centre)", "energy loss", "brach_energy_loss"): (25.0, None),
+    ("ricsac", "rigid PIM (approx. impact centre)", "energy loss", "Brach's PIM (SAE 871993)"): (25.0, None),
 }
 
 
@@ -73,7 +73,7 @@ def comparison(datasets, key):
 # by 33-207 % in the oblique and side tests: Woolley's side inputs differ from the
 # category defaults Neades published (even uncorrected, test 1 gives 67 000 ft·lb
 # against his 48 392), and the capped correction doubles the side energies.
-MISSED = {("ricsac", "CRASH3 (published profiles)", "energy loss", "woolley_1985"):
+MISSED = {("ricsac", "CRASH3 (published profiles)", "energy loss", "Woolley's CRASH3 (1985)"):
           "first run: median 32.5 %, worst 207 % (bound 20 %): Woolley's 1985 side-impact "
           "inputs differ from the published defaults"}
 
