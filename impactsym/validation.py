@@ -281,6 +281,8 @@ def ricsac_energy() -> list[dict[str, Any]]:
                     "brach_pim": _num(data["brach1987_energy_loss_ftlb"]),
                     "measured": _num(data["energy_loss_measured_ftlb"]),
                     "initial": _num(data["initial_energy_ftlb"])})
+        out["impossible"] = ", ".join(k for k in ("published", "published, woolley", "neades")
+                                      if out[k] > out["initial"])
         rows.append(out)
     return rows
 
@@ -496,6 +498,9 @@ def _ricsac() -> Dataset:
                                    lambda r: r["neades_raw_crash"]))
     energy = ricsac_energy()
     ds.tables["energy"] = energy
+    ds.notes += [f"PHYSICALLY IMPOSSIBLE: test {r['test']}: the CRASH3 crush energy ({r['impossible']}) "
+                 f"exceeds the initial kinetic energy ({_fmt(r['initial'])} ft lb)"
+                 for r in energy if r["impossible"]]
     test = lambda r: str(r["test"])  # noqa: E731
     for label, key in (("CRASH3 (published profiles)", "published"),
                        ("CRASH3 (published, Woolley)", "published, woolley"),
@@ -698,7 +703,7 @@ def _detail(ds: Dataset) -> list[str]:
                                        ("CRASH3 pub, Woolley corr.", "published, woolley"),
                                        ("CRASH3 Neades", "neades"), ("Woolley 1985 CRASH3", "woolley_1985"),
                                        ("Brach PIM", "brach_pim"), ("measured", "measured"),
-                                       ("initial KE", "initial")])
+                                       ("initial KE", "initial"), ("exceeds initial KE", "impossible")])
                 + ["", "Rigid PIM with the approximated impact centre (delta-V m/s, energy ft lb; "
                    "sensitivity = largest delta-V change % for a 0.2 m shift of either centre):", ""]
                 + _table(pim, [("test", "test"), ("dV1", "dv1"), ("meas 1", "dv1 Brach & Smith 2002"),

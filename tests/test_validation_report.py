@@ -115,6 +115,16 @@ def test_side_impacts_beyond_45_degrees_are_capped(datasets):
         assert not adjusted[key]["capped"]
 
 
+def test_crush_energy_above_the_initial_kinetic_energy_is_flagged(datasets):
+    """Physically impossible results are flagged, never silently returned."""
+    energy = datasets["ricsac"].tables["energy"]
+    flagged = {r["test"] for r in energy if r["impossible"]}
+    assert flagged == {r["test"] for r in energy
+                       if max(r["published"], r["published, woolley"], r["neades"]) > r["initial"]}
+    notes = [n for n in datasets["ricsac"].notes if n.startswith("PHYSICALLY IMPOSSIBLE")]
+    assert len(notes) == len(flagged)
+
+
 def test_cg_and_effective_mass_delta_v(datasets):
     for row in datasets["ricsac"].tables["crash3 neades"]:
         assert row["dv"] == pytest.approx(row["gamma"] * row["dv_eff"], rel=1e-12)
