@@ -37,6 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from .codes import describe_flags
+from .compare import compare
 from .crash3 import crash3
 from .scene import SceneError
 from .single import solve
@@ -333,6 +334,12 @@ def _ricsac_pim_scene(test: int, shift: tuple[float, float] = (0.0, 0.0)) -> dic
                        "impulse_ratio": "critical", "moment_restitution": 1.0}}
 
 
+# The other impulse-momentum models of the seed on the same RICSAC scenes (via
+# impactsym.compare): the common velocity (Limpert = IMPAC, e = 0) and particles.
+OTHER_PIM_MODELS = {"limpert": "Limpert/IMPAC common velocity (approx. impact centre)",
+                    "particle": "particle (Brach's e, mu_c)"}
+
+
 def ricsac_pim() -> list[dict[str, Any]]:
     """Rigid model on the 11 RICSAC tests with velocities: delta-V [m/s] against
     the measured versions, energy loss [ft·lb] against Brach's and the measured,
@@ -361,6 +368,11 @@ def ricsac_pim() -> list[dict[str, Any]]:
                "measured_energy_loss": _num(row["energy_loss_measured_ftlb"]),
                "brach_tangential": _num(row["brach1987_tangential_loss_ftlb"]),
                "sensitivity_pct": spread}
+        others = {row.model: row for row in compare(_ricsac_pim_scene(test)).rows}
+        for model in OTHER_PIM_MODELS:
+            out[f"{model} energy_loss"] = others[model].energy["total"] / FT_LB
+            for i, vehicle in enumerate(others[model].vehicles, start=1):
+                out[f"{model} dv{i}"] = vehicle.delta_v_magnitude
         for i, vehicle in enumerate(base.vehicles, start=1):
             out[f"dv{i}"] = vehicle.delta_v_magnitude
             for name, col in MEASURED_VERSIONS.items():
@@ -517,6 +529,14 @@ def _ricsac() -> Dataset:
         ds.comparisons.append(Comparison("ricsac", "rigid PIM (approx. impact centre)", "delta-V",
                                          f"measured, {version}" if version in MEASURED_VERSIONS
                                          else "Brach's PIM 2002", tuple(pairs)))
+    for model, label in OTHER_PIM_MODELS.items():
+        pairs = [(f"{r['test']}.{i}", r[f"{model} dv{i}"], r[f"dv{i} Brach & Smith 2002"])
+                 for r in solved for i in (1, 2) if r[f"dv{i} Brach & Smith 2002"] is not None]
+        ds.comparisons.append(Comparison("ricsac", label, "delta-V", "measured, Brach & Smith 2002",
+                                         tuple(pairs)))
+        ds.comparisons.append(_compare("ricsac", label, "energy loss", "measured", solved, test,
+                                       lambda r, m=model: r[f"{m} energy_loss"],
+                                       lambda r: r["measured_energy_loss"]))
     for ref, name in (("measured_energy_loss", "measured"),
                       ("brach_energy_loss", ENERGY_REFERENCES["brach_pim"])):
         ds.comparisons.append(_compare("ricsac", "rigid PIM (approx. impact centre)", "energy loss",
@@ -584,7 +604,8 @@ def _nhtsa() -> Dataset:
 PLOTS = {
     "ricsac": [("delta-V [m/s] vs measured (Brach & Smith 2002)", "measured, Brach & Smith 2002",
                 [("CRASH3 (published profiles)", "delta-V"), ("CRASH3 (Neades' adjustments)", "delta-V"),
-                 ("rigid PIM (approx. impact centre)", "delta-V")]),
+                 ("rigid PIM (approx. impact centre)", "delta-V"),
+                 (OTHER_PIM_MODELS["limpert"], "delta-V")]),
                ("energy loss [ft lb] vs measured", None,
                 [("CRASH3 (published profiles)", "energy loss", "measured"),
                  ("CRASH3 (Neades' adjustments)", "energy loss", "measured"),
@@ -687,7 +708,8 @@ def _detail(ds: Dataset) -> list[str]:
                    "gamma_neades": a["gamma"], "dv_nogamma": g["dv"]}
                   for p, a, g in zip(t["crash3 published"], t["crash3 neades"], t["crash3 neades, gamma = 1"])]
         pim = [{"test": r["test"], **{f"{k}": r.get(k) for k in
-                ("dv1", "dv1 Brach & Smith 2002", "dv2", "dv2 Brach & Smith 2002", "energy_loss",
+                ("dv1", "dv1 Brach & Smith 2002", "dv2", "dv2 Brach & Smith 2002",
+                 "limpert dv1", "limpert dv2", "particle dv1", "particle dv2", "energy_loss",
                  "brach_energy_loss", "measured_energy_loss", "mu_c", "brach_mu", "sensitivity_pct",
                  "status")}} for r in t["pim"]]
         return (["", "CRASH3 delta-V per vehicle [m/s] (CG delta-V; 'eff' = effective-mass delta-V):", ""]
@@ -704,10 +726,14 @@ def _detail(ds: Dataset) -> list[str]:
                                        ("CRASH3 Neades", "neades"), ("Woolley 1985 CRASH3", "woolley_1985"),
                                        ("Brach PIM", "brach_pim"), ("measured", "measured"),
                                        ("initial KE", "initial"), ("exceeds initial KE", "impossible")])
-                + ["", "Rigid PIM with the approximated impact centre (delta-V m/s, energy ft lb; "
-                   "sensitivity = largest delta-V change % for a 0.2 m shift of either centre):", ""]
+                + ["", "Rigid PIM (Brach's e, mu = mu_c, e_m = 1) with the approximated impact centre, "
+                   "and the Limpert/IMPAC common-velocity and particle models on the same scenes "
+                   "(delta-V m/s, energy ft lb; sens. = largest rigid delta-V change % for a 0.2 m "
+                   "shift of either centre):", ""]
                 + _table(pim, [("test", "test"), ("dV1", "dv1"), ("meas 1", "dv1 Brach & Smith 2002"),
                                ("dV2", "dv2"), ("meas 2", "dv2 Brach & Smith 2002"),
+                               ("Limpert dV1", "limpert dv1"), ("Limpert dV2", "limpert dv2"),
+                               ("particle dV1", "particle dv1"), ("particle dV2", "particle dv2"),
                                ("TL", "energy_loss"), ("Brach TL", "brach_energy_loss"),
                                ("measured TL", "measured_energy_loss"), ("mu_c", "mu_c"),
                                ("Brach mu", "brach_mu"), ("sens. %", "sensitivity_pct")])
@@ -747,7 +773,7 @@ def markdown(datasets: list[Dataset], figures: Mapping[str, str] | None = None) 
 def text_summary(datasets: list[Dataset]) -> str:
     """The error statistics as a plain-text table for a terminal."""
     rows = statistics_rows(datasets)
-    head = f"{'dataset':8} {'model':36} {'quantity':22} {'reference':30} {'n':>3} {'median%':>8} {'worst%':>8} {'bias%':>8}"
-    body = [f"{r['dataset']:8} {r['model'][:36]:36} {r['quantity'][:22]:22} {r['reference'][:30]:30} "
+    head = f"{'dataset':8} {'model':52} {'quantity':22} {'reference':30} {'n':>3} {'median%':>8} {'worst%':>8} {'bias%':>8}"
+    body = [f"{r['dataset']:8} {r['model'][:52]:52} {r['quantity'][:22]:22} {r['reference'][:30]:30} "
             f"{r['n']:3d} {r['median']:8.1f} {r['worst']:8.1f} {r['bias']:8.1f}" for r in rows]
     return "\n".join([head, *body])
