@@ -23,8 +23,16 @@ from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
-__all__ = ["CATEGORIES", "FACES", "CLASSES", "Stiffness", "stiffness", "class_dimensions",
-           "LBF", "INCH"]
+__all__ = [
+    "CATEGORIES",
+    "CLASSES",
+    "FACES",
+    "INCH",
+    "LBF",
+    "Stiffness",
+    "class_dimensions",
+    "stiffness",
+]
 
 DATA = Path(__file__).resolve().parent / "data"
 FACES = ("front", "rear", "side")

@@ -32,7 +32,7 @@ import math
 import statistics
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from functools import lru_cache
+from functools import cache, lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -42,8 +42,20 @@ from .crash3 import crash3
 from .scene import SceneError
 from .single import solve
 
-__all__ = ["DATA_DIR", "Comparison", "Dataset", "report", "ricsac_crash3", "ricsac_energy",
-           "ricsac_pim", "ricsac_momentum", "iihs_barrier", "nhtsa", "stats", "ASSUMPTIONS"]
+__all__ = [
+    "ASSUMPTIONS",
+    "DATA_DIR",
+    "Comparison",
+    "Dataset",
+    "iihs_barrier",
+    "nhtsa",
+    "report",
+    "ricsac_crash3",
+    "ricsac_energy",
+    "ricsac_momentum",
+    "ricsac_pim",
+    "stats",
+]
 
 DATA_DIR = Path(__file__).resolve().parent.parent / "validation"
 G_FT = 32.174           # ft/s², standard gravity: weight [lb] → mass [slug]
@@ -133,7 +145,7 @@ def stats(errors: list[float]) -> dict[str, Any]:
 
 # ---------------------------------------------------------------- data
 
-@lru_cache(maxsize=None)
+@cache
 def _read(name: str, data_dir: Path = DATA_DIR) -> tuple[dict[str, str], ...]:
     """A CSV of the validation folder as row dicts (text kept as published)."""
     with open(data_dir / f"{name}.csv", newline="", encoding="utf-8") as handle:
@@ -498,7 +510,7 @@ def _ricsac() -> Dataset:
     published, adjusted, no_arm = ricsac_crash3(False), ricsac_crash3(True), ricsac_crash3(True, arm=False)
     ds.tables.update({"crash3 published": published, "crash3 neades": adjusted,
                       "crash3 neades, gamma = 1": no_arm})
-    vehicle = lambda r: r["vehicle"]  # noqa: E731
+    vehicle = lambda r: r["vehicle"]
     for label, rows in (("CRASH3 (published profiles)", published),
                         ("CRASH3 (Neades' adjustments)", adjusted),
                         ("CRASH3 (Neades, gamma = 1)", no_arm)):
@@ -513,7 +525,7 @@ def _ricsac() -> Dataset:
     ds.notes += [f"PHYSICALLY IMPOSSIBLE: test {r['test']}: the CRASH3 crush energy ({r['impossible']}) "
                  f"exceeds the initial kinetic energy ({_fmt(r['initial'])} ft lb)"
                  for r in energy if r["impossible"]]
-    test = lambda r: str(r["test"])  # noqa: E731
+    test = lambda r: str(r["test"])
     for label, key in (("CRASH3 (published profiles)", "published"),
                        ("CRASH3 (published, Woolley)", "published, woolley"),
                        ("CRASH3 (Neades' adjustments)", "neades")):
@@ -562,8 +574,8 @@ def _iihs() -> Dataset:
     ds = Dataset("iihs", "IIHS small-overlap barrier tests (41, Brach et al. 2014 fits)")
     rows = iihs_barrier()
     ds.tables["barrier"] = rows
-    keep = lambda r: not r["outlier"]  # noqa: E731
-    label = lambda r: r["test"]  # noqa: E731
+    keep = lambda r: not r["outlier"]
+    label = lambda r: r["test"]
     for quantity, key in (("delta-V", "dv"), ("longitudinal delta-V", "dvx"),
                           ("lateral delta-V", "dvy"), ("yaw-rate change", "yaw")):
         ds.comparisons.append(_compare("iihs", "rigid PIM (Brach's fits)", quantity, "measured",
@@ -580,7 +592,7 @@ def _nhtsa() -> Dataset:
     ds = Dataset("nhtsa", "NHTSA car-to-SUV tests 4364, 4438, 4474 (Rose et al. 2006)")
     rows = nhtsa()
     ds.tables["nhtsa"] = rows
-    label = lambda r: f"{r['test']} {r['vehicle']}"  # noqa: E731
+    label = lambda r: f"{r['test']} {r['vehicle']}"
     per_test = [r for i, r in enumerate(rows) if i % 2 == 0]
     for quantity, key in (("energy loss", "energy_loss"), ("normal energy loss", "normal_loss"),
                           ("tangential energy loss", "tangential_loss")):

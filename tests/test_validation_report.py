@@ -145,3 +145,15 @@ def test_statistics_are_of_the_rows():
     assert c.stats() == {"n": 3, "median": pytest.approx(10.0), "worst": pytest.approx(20.0),
                          "bias": pytest.approx(5.0)}
     assert math.isnan(validation.stats([])["median"])
+
+
+def test_cli_validate(capsys, tmp_path):
+    from impactsym.cli import main
+
+    assert main(["validate"]) == 0
+    out = capsys.readouterr().out
+    assert all(name in out for name in ("ricsac", "iihs", "nhtsa"))
+    assert main(["validate", "--markdown", "--plots", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "| model | quantity | reference |" in out and "PHYSICALLY IMPOSSIBLE" in out
+    assert {p.name for p in tmp_path.glob("*.png")} == {"ricsac.png", "iihs.png", "nhtsa.png"}
