@@ -48,6 +48,8 @@ CRITICAL = "critical"
 
 _SCENE_KEYS = ("model", "units", "impact", "vehicles")
 _SCENE_METADATA = ("title", "description", "notes", "comment")
+# Top-level option tables read by one command (impactsym/crash3.py reads "crash3").
+_SCENE_OPTIONS = ("crash3",)
 _COEFFICIENT_KEYS = ("restitution", "impulse_ratio", "moment_restitution", "slip")
 _IMPACT_KEYS = ("normal_angle",) + _COEFFICIENT_KEYS
 _VEHICLE_KEYS = ("name", "mass", "yaw_inertia", "velocity", "yaw_rate", "impact_point", "fixed")
@@ -273,13 +275,16 @@ def _parse_scene(data: Any, source: Path | None, kind: str) -> Scene:
         raise SceneError(f"{where}a scene must be an object (a table of keys), got {show_value(data)}")
     model = _choice(data.get("model", "rigid"), "model", MODELS, "model")
     units = _choice(_require(data, "units", ""), "units", UNITS, "units")
-    impact_data = _mapping(_require(data, "impact", ""), "impact")
+    # CRASH3 uses the impact geometry only for delta-V directions and moment arms.
+    no_impact = kind == "crash3" and "impact" not in data
+    impact_data = {} if no_impact else _mapping(_require(data, "impact", ""), "impact")
     if kind == "inverse" and PRESETS[model]["kernel"] not in ("rigid", "particle"):
         raise SceneError(f"the {model} model has no inverse solution", "model")
-    impact = _parse_impact(impact_data, kind, model)
+    impact = Impact(normal_angle=math.nan, restitution=math.nan, impulse_ratio=math.nan,
+                    moment_restitution=math.nan) if no_impact else _parse_impact(impact_data, kind, model)
     vehicles = _parse_vehicles(_require(data, "vehicles", ""), model, kind)
     extra = {key: data[key] for key in data if key not in _SCENE_KEYS}
-    warnings = _ignored(extra, "", _SCENE_METADATA)
+    warnings = _ignored(extra, "", _SCENE_METADATA + _SCENE_OPTIONS)
     warnings += _ignored(impact_data, "impact", _IMPACT_KEYS)
     if kind in ("forward", "inverse"):
         warnings += _unused_coefficients(impact_data, model)
