@@ -21,7 +21,7 @@ outputs ``V1x V1y W1 V2x V2y W2 Pn Pt M mu mu_c TL TLn TLt TLm``):
 Variants are rendered into a temporary directory as real ``.py`` files and imported
 (numba cannot cache code that was exec'd), so each run compiles them afresh.
 
-Error of an output = |got - reference| / its natural scale (``tests.reference``);
+Error of an output = |got - reference| / its natural scale (``impactsym.testing.reference``);
 error of a row = the largest over the 15 outputs; a row whose output is NaN or
 infinite where the reference is finite has infinite error ("fail"). Reported per
 set: the worst row and the 99th percentile (the smallest error that at least 99 %
@@ -437,7 +437,7 @@ def markdown(methods, timing, errors, sets, args) -> str:
         "*p99* (99 % of rows are within it). A row whose output is NaN where the reference is "
         "finite fails (infinite error). *bits*: bits lost on the worst row, log2(worst / 2^-53).",
         "",
-        f"Sets: **realistic** = `tests.scenes.random_realistic({sets['realistic'].n}, "
+        f"Sets: **realistic** = `impactsym.testing.scenes.random_realistic({sets['realistic'].n}, "
         f"seed={S.REALISTIC_SEED})`; **stress** = `benchmarks.sets.stress_set()`, "
         f"{sets['stress'].n} constructed rows (families below).",
         "",

@@ -226,9 +226,10 @@ def _vehicle_result(vehicle, out: Mapping[str, Any], number: int) -> VehicleResu
 
 def road_speed_rows(units: str, speeds) -> list[tuple]:
     """Table rows of speeds (``(label, [per vehicle])`` in the system's speed
-    unit) in the unit people read: mph (US) or km/h (SI)."""
+    unit, None where unknown) in the unit people read: mph (US) or km/h (SI)."""
     label, factor = ROAD_SPEED[units]
-    return [(f"{name} [{label}]", *(factor * value for value in values)) for name, values in speeds]
+    return [(f"{name} [{label}]", *(None if value is None else factor * value for value in values))
+            for name, values in speeds]
 
 
 def table_cell(value: float) -> str:

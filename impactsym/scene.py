@@ -343,7 +343,9 @@ def _parse_scene(data: Any, source: Path | None, kind: str) -> Scene:
     check_keys(data, TOP_KEYS, "")
     model = _choice(data.get("model", "rigid"), "model", MODELS, "model")
     units = _choice(_require(data, "units", ""), "units", UNITS, "units")
-    impact_data = _mapping(_require(data, "impact", ""), "impact")
+    # CRASH3 uses the impact geometry only for delta-V directions and moment arms.
+    no_impact = kind == "crash3" and "impact" not in data
+    impact_data = {} if no_impact else _mapping(_require(data, "impact", ""), "impact")
     check_keys(impact_data, IMPACT_KEYS, "impact")
     if kind == "inverse" and PRESETS[model]["kernel"] not in ("rigid", "particle"):
         raise SceneError(f"the {model} model has no inverse solution", "model")
@@ -353,14 +355,16 @@ def _parse_scene(data: Any, source: Path | None, kind: str) -> Scene:
     if all(fixed):
         raise SceneError("both vehicles are fixed; at most one may be", "vehicles")
     coefficients = _parse_coefficients(impact_data, reading)
-    reading.leaves.number(_require(impact_data, "normal_angle", "impact"), "impact.normal_angle", "angle")
+    if not no_impact:
+        reading.leaves.number(_require(impact_data, "normal_angle", "impact"), "impact.normal_angle",
+                              "angle")
     extras = [_read_vehicle(entry, index, is_fixed, reading)
               for index, (entry, is_fixed) in enumerate(zip(raw_vehicles, fixed))]
     leaves = reading.used_leaves()
     correlations = parse_correlations(data["correlations"], leaves) if "correlations" in data else ()
     values = {path: leaf.nominal for path, leaf in reading.leaves.leaves.items()}
     states = [vehicle_state(values, index, units) for index in range(2)]
-    given = values["impact.normal_angle"]
+    given = values.get("impact.normal_angle", math.nan)
     used = {path: leaf.nominal for path, leaf in leaves.items()}
     points = [vehicle_state(used, index, units)["r"] for index in range(2)]
     angle, flipped = used_normal_angle(given, *points)
@@ -724,7 +728,8 @@ def scene_columns(scene: Scene, overrides: Mapping[str, Any] | None = None) -> S
             outside = ~((arrays[path] >= low) & (arrays[path] <= high))
             reason[outside & (reason == "")] = f"{path} is outside [{low:g}, {high:g}]"
     states = [_row_state(scene, values, index) for index in range(2)]
-    angle, flipped = used_normal_angle(values["impact.normal_angle"], states[0]["r"], states[1]["r"])
+    angle, flipped = used_normal_angle(values.get("impact.normal_angle", math.nan), states[0]["r"],
+                                       states[1]["r"])
     gamma = np.deg2rad(angle) if np.ndim(angle) else math.radians(float(angle))
     columns = _KIND_COLUMNS[scene.kind](scene, values, states, gamma)
     return SceneColumns(scene.kind, scene.model, rows, columns, reason, flipped)
