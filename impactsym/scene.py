@@ -350,6 +350,8 @@ def _parse_scene(data: Any, source: Path | None, kind: str) -> Scene:
     if kind == "inverse" and PRESETS[model]["kernel"] not in ("rigid", "particle"):
         raise SceneError(f"the {model} model has no inverse solution", "model")
     reading = _Reading(kind, model, units)
+    if "crash3" in data and kind != "crash3":
+        reading.not_used("crash3", "the CRASH3 options are read by crash3 and compare")
     raw_vehicles = _vehicle_list(_require(data, "vehicles", ""))
     fixed = tuple(_fixed(entry, index) for index, entry in enumerate(raw_vehicles))
     if all(fixed):

@@ -249,7 +249,7 @@ def test_reconstruction_heading_serves_both_travel_and_vehicle_frame():
     a, b = impactsym.reconstruct(data), impactsym.reconstruct(words)
     for va, vb in zip(a.vehicles, b.vehicles):
         assert vb.speed == pytest.approx(va.speed, rel=1e-12, abs=1e-12)
-    assert b.TL == pytest.approx(a.TL, rel=1e-12)
+    assert pytest.approx(a.TL, rel=1e-12) == b.TL
 
 
 # --------------------------------------------------------------------------- one-line errors, exit 2
@@ -334,6 +334,9 @@ def test_keys_a_command_does_not_use_are_reported():
     forward["vehicles"][0]["crush"] = {"A": 300, "B": 90, "width": 60, "depths": [5, 5], "pdof": 0}
     assert any(w.startswith("vehicles[0].crush is given but not used") for w in impactsym.solve(forward).warnings)
 
+    options = {**copy.deepcopy(PLAIN), "crash3": {"restitution": 0.1}}
+    assert any(w.startswith("crash3 is given but not used") for w in impactsym.solve(options).warnings)
+
     barrier = json.loads((EXAMPLES / "barrier_si.json").read_text())
     fixed = next(i for i, v in enumerate(barrier["vehicles"]) if v.get("fixed"))
     barrier["vehicles"][fixed]["mass"] = 1e6
@@ -416,7 +419,7 @@ def test_scene_columns_rows_equal_scenes_loaded_one_by_one():
     draws["vehicles[0].weight"][4] = -10.0
     out = scene_columns(scene, draws)
     assert out.rows == n
-    assert list(out.reason) == ["", "", "impact.restitution is outside [0, 1]", "", 
+    assert list(out.reason) == ["", "", "impact.restitution is outside [0, 1]", "",
                                 "vehicles[0].weight is not positive", ""]
     assert list(out.flipped) == [False, False, False, True, False, False]
     for row in (0, 1, 3, 5):
