@@ -477,3 +477,32 @@ def test_plain_scenes_do_not_import_pint():
     done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True,
                           timeout=300, check=False)
     assert done.returncode == 0, done.stderr
+
+
+def _as_inverse(scene):
+    """The scene with its velocities (either form) as final velocities."""
+    scene = copy.deepcopy(scene)
+    for vehicle in scene["vehicles"]:
+        vehicle["final_velocity"] = vehicle.pop("velocity")
+        vehicle["final_yaw_rate"] = vehicle.pop("yaw_rate")
+    return scene
+
+
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(scenes())
+def test_alternative_forms_give_the_plain_inverse_and_reconstruction_columns(pair):
+    plain, words = (_as_inverse(scene) for scene in pair)
+    for kind in ("inverse", "reconstruct"):
+        if kind == "reconstruct":  # the words' headings place their impact points too
+            for given, worded in zip(plain["vehicles"], words["vehicles"]):
+                given["heading"] = worded["heading"]
+        a = scene_columns(load_scene(plain, kind=kind)).columns
+        b = scene_columns(load_scene(words, kind=kind)).columns
+        assert set(a) == set(b)
+        for name in a:
+            if name == "gamma":
+                assert math.cos(a[name]) == pytest.approx(math.cos(b[name]), abs=1e-12)
+                assert math.sin(a[name]) == pytest.approx(math.sin(b[name]), abs=1e-12)
+            else:
+                group = [v for k, v in a.items() if k[:1] == name[:1] and k != "gamma"]
+                assert abs(a[name] - b[name]) <= 1e-12 * _scale(group), name
