@@ -75,6 +75,7 @@ from typing import Any, Union
 from generated.codes import FLAG_PDOF_CAPPED
 
 from . import _kernels
+from .casefile import check_keys
 from .codes import describe_status
 from .crash3_tables import CLASSES, FACES, class_dimensions, stiffness
 from .result import UNIT_LABELS, road_speed_rows
@@ -241,6 +242,7 @@ def crash3(scene: Union[Scene, Mapping, str, Path], restitution: float | None = 
     """
     data = scene_data(scene)
     parsed = load_scene(data, kind="crash3")
+    _check_crush_keys(parsed)
     options = _options(data, restitution, energy, correction)
     geometry = not math.isnan(parsed.impact.normal_angle)
     gamma = math.radians(parsed.impact.normal_angle) if geometry else 0.0
@@ -260,7 +262,7 @@ def crash3(scene: Union[Scene, Mapping, str, Path], restitution: float | None = 
     vehicles = tuple(_vehicle(v, c, energies[i], out, values, i + 1, implied, geometry)
                      for i, (v, c) in enumerate(zip(parsed.vehicles, crush)))
     warnings = _capped(crush, energies, options.correction) + _warnings(vehicles, crush, implied) \
-        + _unknown_crush_keys(parsed) + list(parsed.warnings)
+        + list(parsed.warnings)
     return Crash3Result(parsed.units, options, vehicles, values["E"], out["P"], warnings)
 
 
@@ -497,11 +499,12 @@ def _warnings(vehicles, crush, implied: dict | None) -> list[str]:
     return warnings
 
 
-def _unknown_crush_keys(scene: Scene) -> list[str]:
-    """Warnings for keys of a crush table that CRASH3 does not read (likely typos)."""
-    return [f"ignored unknown key vehicles[{i}].crush.{key}"
-            for i, v in enumerate(scene.vehicles) if "crush" in v.extra
-            for key in v.extra["crush"] if key not in CRUSH_KEYS]
+def _check_crush_keys(scene: Scene) -> None:
+    """An unknown key of a crush table (a likely typo) is an error naming it, with
+    the nearest known key, as everywhere else in a scene."""
+    for i, vehicle in enumerate(scene.vehicles):
+        if "crush" in vehicle.extra:
+            check_keys(vehicle.extra["crush"], CRUSH_KEYS, f"vehicles[{i}].crush")
 
 
 def _cell(value: float | None) -> str:

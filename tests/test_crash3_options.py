@@ -183,6 +183,7 @@ def test_compare_runs_a_crush_only_scene():
     ({"B": 0.0}, "vehicles[0].crush.B: must be > 0"),
     ({"category": 3, "face": "front"}, "vehicles[0].crush.category: give either A and B or category"),
     ({"pdof": 90.0}, "vehicles[0].crush.pdof: |pdof| = 90 must be < 90"),
+    ({"widht": 1.5}, 'vehicles[0].crush.widht: unknown key; did you mean "width"?'),
 ])
 def test_bad_crush_is_one_line_exit_2(change, field, tmp_path, capsys):
     data = barrier(**change)
