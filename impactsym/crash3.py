@@ -43,7 +43,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Union
 
-from generated.codes import STATUS_PDOF_BEYOND_LIMIT
+from ._kernels import STATUS_PDOF_BEYOND_LIMIT
 
 from . import _kernels
 from .codes import describe_status

@@ -35,7 +35,7 @@ if sys.version_info >= (3, 11):
 else:
     import tomli as tomllib
 
-from generated.presets import PRESETS
+from ._kernels import PRESETS
 
 __all__ = ["SceneError", "Vehicle", "Impact", "Scene", "load_scene", "scene_data", "uses_yaw",
            "MODELS", "UNITS"]

@@ -6,7 +6,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Union
 
-from generated.codes import STATUS_NOT_APPROACHING
+from ._kernels import STATUS_NOT_APPROACHING
 
 from . import _kernels
 from .codes import describe_status
