@@ -197,7 +197,7 @@ class Program:
     operations: int
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def program(kernel: Kernel, style: Style = DEFAULT) -> Program:
     """Common subexpressions eliminated over the whole kernel; each temporary
     is placed at the start of the first block that needs it (directly or
