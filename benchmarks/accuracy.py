@@ -36,6 +36,7 @@ scene, and its ratio to the default kernel.
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import math
 import os
@@ -43,9 +44,9 @@ import platform
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -177,10 +178,8 @@ def _solve_stack(A, b):
     except np.linalg.LinAlgError:
         x = np.full(b.shape[:2], np.nan)
         for i in range(A.shape[0]):
-            try:
+            with contextlib.suppress(np.linalg.LinAlgError):  # a singular row stays NaN
                 x[i] = np.linalg.solve(A[i], b[i])[:, 0]
-            except np.linalg.LinAlgError:
-                pass
         return x
 
 
@@ -329,7 +328,7 @@ def set_errors(outs: dict, scene_set, energy_floor: float = 1e-10) -> SetErrors:
     """Natural-scale errors of ``outs`` (arrays by output name) against the set's references."""
     from mpmath import mp
 
-    from tests import reference as R
+    from impactsym.testing import reference as R
 
     n = scene_set.n
     row = np.empty(n)
@@ -580,8 +579,7 @@ def chart(methods, timing, errors, path: Path, n: int) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import (FixedLocator, FormatStrFormatter, NullFormatter,
-                                   NullLocator)
+    from matplotlib.ticker import FixedLocator, FormatStrFormatter, NullFormatter, NullLocator
 
     colors = plt.get_cmap("tab10").colors
     fig, axes = plt.subplots(1, 2, figsize=(13, 5.8), sharey=True, constrained_layout=True)

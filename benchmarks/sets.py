@@ -20,8 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 from mpmath import mp
 
-from tests import reference as R
-from tests import scenes
+from impactsym.testing import reference as R
+from impactsym.testing import scenes
 
 INPUTS = tuple(R.RIGID_INPUTS)
 REALISTIC_SEED = 20260611

@@ -15,11 +15,11 @@ on vehicle 1; lower case initial, upper case final).
     draws = impactsym.sample("examples/two_car_us.json", {"e": ("uniform", 0, 0.3)}, 1000, seed=1)
 """
 
+from . import plot
 from .batch import solve_batch
+from .codes import FLAG_MESSAGES, STATUS_MESSAGES, describe_flags, describe_status
 from .compare import compare
 from .crash3 import crash3
-from .codes import FLAG_MESSAGES, STATUS_MESSAGES, describe_flags, describe_status
-from . import plot
 from .energy import delta_v_from_energy
 from .explore import explore
 from .inverse import invert, invert_batch

@@ -128,8 +128,8 @@ def _run_compare(args: argparse.Namespace) -> int:
     if args.plot:
         try:
             result.plot(args.plot)
-        except ImportError:
-            raise UsageError("--plot needs matplotlib (pip install 'impactsym[plot]')") from None
+        except ImportError as exc:
+            raise UsageError(str(exc)) from None
     if args.markdown:
         print(result.markdown())
         return 0

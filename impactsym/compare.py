@@ -31,6 +31,7 @@ from typing import Any, Union
 from ._kernels import PRESETS
 
 from . import _kernels
+from ._util import require
 from .crash3 import crash3
 from .result import UNIT_LABELS, Result
 from .scene import Scene, SceneError, load_scene, scene_data, uses_yaw
@@ -150,7 +151,7 @@ class Comparison:
         """Bar charts of |delta-V| per vehicle and of the energy loss (% of the
         initial kinetic energy, stacked normal/tangential/moment) by model, saved
         to `path` (needs matplotlib: ``pip install 'impactsym[plot]'``)."""
-        import matplotlib
+        matplotlib = require("matplotlib", extra="plot", what="compare --plot")
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt

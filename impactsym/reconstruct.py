@@ -13,7 +13,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Union
+from typing import Any
 
 from . import _kernels
 from .batch import run_columns
@@ -129,7 +129,7 @@ class Reconstruction:
         return "\n".join(lines)
 
 
-def reconstruct(scene: Union[Scene, Mapping, str, Path]) -> Reconstruction:
+def reconstruct(scene: Scene | Mapping | str | Path) -> Reconstruction:
     """Reconstruct the pre-impact speeds of a scene whose vehicles give
     ``final_velocity``, ``final_yaw_rate``, ``heading`` (degrees) and optionally
     ``yaw_rate`` (pre-impact, default 0); ``impact`` needs only ``normal_angle``.

@@ -10,8 +10,9 @@ minus after, so a negative value means the coefficients created energy.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, Mapping
+from typing import Any
 
 from .codes import describe_flags
 from .scene import Scene, uses_yaw
@@ -85,7 +86,7 @@ class Result:
         return "solve" if self.direction == "forward" else "invert"
 
     @classmethod
-    def from_kernel(cls, scene: Scene, out: Mapping[str, Any]) -> "Result":
+    def from_kernel(cls, scene: Scene, out: Mapping[str, Any]) -> Result:
         """Combine a scene with the output of ``_kernels.solve_one`` (status 0)."""
         flags = int(out["flags"])
         return cls(
