@@ -18,11 +18,14 @@ import math
 import os
 import sys
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
 
-import generated
+try:  # an installed wheel maps generated/ into the package
+    from . import _generated as generated
+except ImportError:  # a checkout (or editable install): generated/ at the top
+    import generated
 
 if getattr(generated, "IMPACTSYM_GENERATED", None) != "impactsym":
     raise ImportError(
@@ -30,13 +33,20 @@ if getattr(generated, "IMPACTSYM_GENERATED", None) != "impactsym":
         "impactsym's generated kernels (another package named 'generated' shadows it)"
     )
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from generated import (  # noqa: E402
-    crash3, delta_v, inverse, particle, planar, presets, reconstruct, report,
-)
-from generated import codes as CODES  # noqa: E402
-from generated.presets import COEFFICIENT_INPUTS, PRESETS  # noqa: E402
+
+def _generated(name: str):
+    """generated/<name>.py (plain Python, or numba for a *_jit module)."""
+    return importlib.import_module(f"{generated.__name__}.{name}")
+
+
+crash3, delta_v, inverse, particle, planar, presets, reconstruct, report = (
+    _generated(name) for name in ("crash3", "delta_v", "inverse", "particle", "planar",
+                                  "presets", "reconstruct", "report"))
+CODES = _generated("codes")
+PRESETS = presets.PRESETS
+COEFFICIENT_INPUTS = presets.COEFFICIENT_INPUTS
 
 STATUS_NOT_APPROACHING = CODES.STATUS_NOT_APPROACHING
 STATUS_PDOF_BEYOND_LIMIT = CODES.STATUS_PDOF_BEYOND_LIMIT
@@ -101,7 +111,7 @@ def _jit_module(model: str):
     """generated/<model>_jit.py, imported (with numba) on first use."""
     if model not in _JIT_MODULES:
         _set_numba_cache_dir()
-        _JIT_MODULES[model] = importlib.import_module(f"generated.{model}_jit")
+        _JIT_MODULES[model] = _generated(f"{model}_jit")
     return _JIT_MODULES[model]
 
 
@@ -261,16 +271,12 @@ def _columns_for(ks: KernelSet, inputs: list, n: int) -> tuple[list, bool]:
     angle = inputs[at]
     if not isinstance(angle, np.ndarray):
         return inputs[:at] + list(ks.unit_normal(angle)) + inputs[at + 1:], True
-    limit = _plain_module(ks.model).SINCOS_LIMIT
+    limit = _generated(ks.model).SINCOS_LIMIT
     if np.any(np.isfinite(angle) & (np.abs(angle) > limit)):
         with np.errstate(invalid="ignore"):
             normal = [np.cos(angle), np.sin(angle)]
         return inputs[:at] + normal + inputs[at + 1:], True
     return inputs, False
-
-
-def _plain_module(model: str):
-    return importlib.import_module(f"generated.{model}")
 
 
 def _compile_notice(ks: KernelSet, driver, parallel: bool):

@@ -89,7 +89,7 @@ def test_manifest_describes_every_kernel():
     for name, row in p.MANIFEST.items():
         assert callable(getattr(p, name)) and row["operations"] > 0
         assert row["angle"] == "gamma" and "gamma" in row["columns"]
-        assert ("nx", "ny") == row["arguments"][14:16]
+        assert row["arguments"][14:16] == ("nx", "ny")
         for suffix in ("", "_serial", "_normal", "_normal_serial"):
             assert callable(getattr(pj, f"{name}_batch{suffix}"))
     assert p.MANIFEST["rigid_em1"]["constants"] == {"M": 0.0, "TLm": 0.0}
