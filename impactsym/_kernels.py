@@ -8,7 +8,7 @@ below `SERIAL_BELOW` rows (a `prange` launch costs more than it saves), the
 parallel one above. Every driver argument is a C-contiguous float64 array, so
 each driver compiles once per machine (numba's on-disk cache) whatever mix of
 scalar and array columns a caller gives: a scalar column becomes a filled
-array, `CHUNK` rows at a time.
+array, reused chunk after chunk (`FILL_BYTES`).
 """
 
 from __future__ import annotations
@@ -84,9 +84,11 @@ def requested_outputs(outputs) -> tuple[tuple[str, ...], str]:
     return names, tier
 
 
-# A scalar column becomes a filled array of at most this many rows, reused
-# chunk after chunk (128 KiB per column: the fills stay in cache).
-CHUNK = 16384
+# Scalar columns become filled arrays of at most FILL_BYTES together (and at
+# least MIN_CHUNK rows), reused chunk after chunk. Few large chunks: on a busy
+# machine every parallel call waits for its threads to be scheduled.
+FILL_BYTES = 64 << 20
+MIN_CHUNK = 1 << 16
 
 # Seconds a driver may compile before the user is told why the call waits.
 COMPILE_NOTICE_AFTER = 2.0
@@ -294,8 +296,8 @@ def _compile_notice(ks: KernelSet, driver, parallel: bool):
 
 
 def _call(ks: KernelSet, driver, parallel: bool, columns: list, outs: list) -> None:
-    """Run `driver` over all rows; scalar columns become filled arrays,
-    CHUNK rows at a time (every argument a C-contiguous float64 array, so
+    """Run `driver` over all rows; scalar columns become filled arrays, a
+    chunk of rows at a time (every argument a C-contiguous float64 array, so
     the driver has one compiled signature)."""
     n = outs[-1].shape[0]
     timer = _compile_notice(ks, driver, parallel)
@@ -303,7 +305,8 @@ def _call(ks: KernelSet, driver, parallel: bool, columns: list, outs: list) -> N
         if all(isinstance(c, np.ndarray) for c in columns):
             driver(*columns, *outs)
             return
-        size = min(n, CHUNK)
+        scalars = sum(not isinstance(c, np.ndarray) for c in columns)
+        size = min(n, max(MIN_CHUNK, FILL_BYTES // (8 * scalars)))
         fills = [None if isinstance(c, np.ndarray) else np.full(size, c) for c in columns]
         for start in range(0, n, size):
             stop = min(start + size, n)

@@ -123,14 +123,15 @@ def test_any_mix_of_scalars_and_arrays_uses_one_compiled_signature():
 
 
 def test_scalars_are_filled_chunk_by_chunk(monkeypatch):
-    """A batch longer than CHUNK with scalar columns gives the rows a single
+    """A batch longer than a chunk with scalar columns gives the rows a single
     call would give (each chunk its own slice of the outputs)."""
     from impactsym import _kernels
 
     c = _rigid(250, seed=6)
     mixed = {k: (float(v[0]) if k in ("m1", "e") else v) for k, v in c.items()}
     whole = impactsym.solve_batch(mixed)
-    monkeypatch.setattr(_kernels, "CHUNK", 64)
+    monkeypatch.setattr(_kernels, "FILL_BYTES", 8 * 2 * 64)  # two scalars: 64-row chunks
+    monkeypatch.setattr(_kernels, "MIN_CHUNK", 64)
     chunked = impactsym.solve_batch(mixed)
     for name in (*OUTPUTS, "status", "flags"):
         np.testing.assert_array_equal(chunked[name], whole[name], err_msg=name)
