@@ -967,7 +967,7 @@ def markdown(args, code: str, cases: dict, ok: dict, quiet: Quiet, simd: dict, b
               "the row's largest speed. NumPy's solve runs on one core, impactsym on "
               f"{os.cpu_count()}.",
               "",
-              f"## 3. Start-up (fresh processes, median of {STARTUP_RUNS})",
+              f"## 3. Start-up (fresh processes, least of {start['waits']['runs']})",
               "",
               "| what | seconds | target |",
               "|---|---:|---:|",
