@@ -93,7 +93,8 @@ def _kernel_blocks(sticking: bool):
         ),
         Block(((gn, gn_), (gt, gt_), (mbar, 1 / (k1 + k2))), f.approach_guard(),
               equation="approach in the impact frame (seed Fig. 1); reduced mass (seed eq 17)"),
-        Block(((dgn, -(1 + e) * gn), (dgt, dgt_)),
+        # e = -1 (or an underflowing product) gives no normal impulse: mu_c divides by dgn.
+        Block(((dgn, -(1 + e) * gn), (dgt, dgt_)), Guard((sp.Ne(dgn, 0),), "SINGULAR"),
               equation="restitution (seed eq 3); " + ("end of sliding (seed eq 8)" if sticking
                                                       else "impulse ratio (seed eq 5)")),
         Block(
