@@ -85,15 +85,20 @@ def variant_source(kind: str) -> tuple[str, str]:
     """``(text, kernel name)`` of a variant module rendered by ``derive.emit``:
     ``kind`` is ``"fastmath"``, ``"float32"`` or
     ``"ke_difference"`` (the naive-energy kernel, default style)."""
+    from derive import emit
+
+    kernels, style = _variant_kernels(kind)
+    text = emit.render_jit_module("planar.py", kernels, emit.source_hash(), style)
+    return text, kernels[0].name
+
+
+def _variant_kernels(kind: str) -> tuple[list, object]:
+    """(the kernels, the emitter style) of a variant."""
     from derive import emit, planar
 
-    doc = (planar.__doc__ or "").strip().splitlines()[0]
     if kind == "ke_difference":
-        kernels, style = [planar.ke_difference_kernel()], emit.DEFAULT
-    else:
-        kernels, style = list(planar.KERNELS[:1]), emit.VARIANTS[kind]
-    text = emit.render_module("planar.py", doc, kernels, emit.source_hash(), style)
-    return text, kernels[0].name
+        return [planar.ke_difference_kernel()], emit.DEFAULT
+    return list(planar.KERNELS[:1]), emit.VARIANTS[kind]
 
 
 def variant_module(kind: str):
@@ -105,6 +110,8 @@ def variant_module(kind: str):
         return _VARIANTS[kind]
     if _TMP is None:
         _TMP = tempfile.TemporaryDirectory(prefix="impactsym_bench_")
+    from derive import emit
+
     text, name = variant_source(kind)
     modname = f"_impactsym_bench_{kind}"
     path = Path(_TMP.name) / f"{modname}.py"
@@ -114,6 +121,7 @@ def variant_module(kind: str):
     sys.modules[modname] = module  # numba's cache re-imports the module by name
     spec.loader.exec_module(module)
     module.KERNEL_NAME = name
+    module.MANIFEST = {k.name: emit.manifest_entry(k, 0) for k in _variant_kernels(kind)[0]}
     _VARIANTS[kind] = module
     return module
 
@@ -121,8 +129,8 @@ def variant_module(kind: str):
 def _kernel_bind(module, name: str, dtype) -> Callable[[dict], Callable[[], dict]]:
     """A batch driver with inputs cast to ``dtype`` and preallocated outputs."""
     driver = getattr(module, f"{name}_batch")
-    inputs = getattr(module, f"{name.upper()}_INPUTS")
-    outputs = getattr(module, f"{name.upper()}_OUTPUTS")
+    inputs = module.MANIFEST[name]["columns"]
+    outputs = module.MANIFEST[name]["outputs"]
 
     def bind(columns):
         args = [np.ascontiguousarray(columns[k], dtype=dtype) for k in inputs]
@@ -256,7 +264,10 @@ def _lambdify_bind_factory():
 def build_methods() -> list[Method]:
     """Every method, the default first. Renders and imports the variants."""
     import impactsym  # noqa: F401  (checks that `generated` is impactsym's)
-    from generated import planar as gen
+    from generated import planar, planar_jit
+
+    gen = planar_jit
+    gen.MANIFEST = planar.MANIFEST
 
     methods = [Method("default", "default",
                       "generated/planar.py `rigid_batch`: strict IEEE float64, prange "

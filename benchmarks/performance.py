@@ -2,7 +2,7 @@
 user would write, start-up times, the serial/parallel threshold and a large sweep.
 
 ``python -m benchmarks performance [--n 1000000] [--repeat 7] [--sweep | --no-sweep]
-[--sweep-points 1e8] [--out benchmarks/results]``
+[--sweep-points 1e8] [--quick] [--out benchmarks/results]``
 
 1. **Memory ceiling.** For each case, a trivial ``@njit(parallel=True)`` ``prange``
    kernel reads every *array* column the real call is given (scalars are not memory)
@@ -18,9 +18,14 @@ user would write, start-up times, the serial/parallel threshold and a large swee
    ``numpy.linalg.solve`` in a Python loop, and batched on (rows, 9, 9) stacks
    (``benchmarks.accuracy._linear_bind``); per-scene time against impactsym's per-scene
    time of case (a), same run.
-3. **Start-up**, each in a fresh subprocess, median of 5 after one untimed warm-up run:
-   ``impactsym solve examples/intersection_si.toml`` wall time; ``import impactsym`` and
-   the first ``solve_batch`` call on the n rows of case (a) with numba's cache warm.
+3. **Start-up and compile waits**, each in a fresh subprocess, least of 5 after one
+   untimed warm-up run: ``impactsym solve examples/intersection_si.toml`` wall time;
+   ``import impactsym`` (and whether it imports numba) and the first ``solve_batch``
+   call on the n rows of case (a) with numba's cache warm, and with an empty cache (a
+   temporary NUMBA_CACHE_DIR: the first use on a machine). After that first use, calls
+   never made before (three scalar/array mixes of ``solve_batch``, one ``sweep``,
+   ``sample``, ``invert_batch``, ``reconstruct_batch``; ``WAIT_CALLS``): the wait of the
+   first run over the second in the same process.
 4. **Serial threshold.** Serial twin against parallel driver for n = 1, 2, 4, ..., 4096,
    called directly (preallocated outputs) and through ``run_batch`` (its SERIAL_BELOW
    forced to always-serial / always-parallel); per n the median of many interleaved calls.
@@ -49,7 +54,6 @@ import platform
 import re
 import resource
 import shutil
-import statistics
 import subprocess
 import sys
 import tempfile
@@ -310,9 +314,9 @@ def build_cases(n: int, log) -> list[Case]:
         Case("b", "(b) rigid, constant normal (gamma scalar), all outputs", constant, {}, rigid,
              0.70),
         Case("c", "(c) rigid, e_m = 1 on every row, all outputs", em1, {},
-             ("rigid", False, True, "energy"), 0.70),
+             ("rigid", False, True, "energy"), 0.60),
         Case("d", "(d) particle, all outputs", particle, {"model": "particle"},
-             ("particle", False, False, "energy"), 0.80),
+             ("particle", False, False, "energy"), 0.60),
         Case("e", "(e) rigid, per-row angle, velocities tier", general, {"outputs": "velocities"},
              velocities, None),
         Case("crit", "rigid, mu = critical, all outputs", critical, {},
@@ -483,14 +487,107 @@ import json, sys, time
 t0 = time.perf_counter()
 import impactsym
 t1 = time.perf_counter()
+numba_on_import = "numba" in sys.modules
 import numpy as np
 with np.load(sys.argv[1]) as data:
     columns = {k: data[k] for k in data.files}
 t2 = time.perf_counter()
 impactsym.solve_batch(columns)
 t3 = time.perf_counter()
-print(json.dumps({"import_s": t1 - t0, "call_s": t3 - t2}))
+print(json.dumps({"import_s": t1 - t0, "call_s": t3 - t2, "numba_on_import": numba_on_import}))
 """
+
+# A call measured in a fresh process: its first run (loading or compiling the drivers it
+# needs) and a second run (steady state); the difference is what the user waits for.
+_WAIT = """\
+import json, sys, time
+from benchmarks.performance import wait_call
+call = wait_call(sys.argv[1], sys.argv[2])
+t0 = time.perf_counter()
+call()
+t1 = time.perf_counter()
+call()
+t2 = time.perf_counter()
+print(json.dumps({"first_s": t1 - t0, "steady_s": t2 - t1}))
+"""
+
+# Calls never made before on this machine's cache, after the package's first use (one
+# solve_batch on case (a): every column an array, an angle per row). Three scalar/array
+# mixes of solve_batch, then one call of each other batch API.
+WAIT_CALLS = {
+    "mix: masses and inertias scalar": "solve_batch, m1 m2 I1 I2 scalars, the rest arrays",
+    "mix: e, mu, e_m scalar": "solve_batch, e mu e_m scalars, the rest arrays",
+    "mix: one normal, arms scalar": "solve_batch, gamma r1x r1y r2x r2y scalars, the rest arrays",
+    "sweep": f"impactsym.sweep('{SCENE_FILE}', e=30 values, mu=30 values)",
+    "sample": f"impactsym.sample('{SCENE_FILE}', e uniform, mu uniform, n=5000)",
+    "invert_batch": "impactsym.invert_batch on 10,000 solved rows",
+    "reconstruct_batch": "impactsym.reconstruct_batch on 10,000 solved rows",
+}
+
+
+def wait_call(kind: str, path: str) -> Callable[[], object]:
+    """The zero-argument call of WAIT_CALLS ``kind`` on the case-(a) columns in ``path``
+    (an .npz); inputs are built outside the call."""
+    with np.load(path) as data:
+        c = {k: data[k] for k in data.files}
+    scalars = {"mix: masses and inertias scalar": ("m1", "m2", "I1", "I2"),
+               "mix: e, mu, e_m scalar": ("e", "mu", "e_m"),
+               "mix: one normal, arms scalar": ("gamma", "r1x", "r1y", "r2x", "r2y")}
+    if kind in scalars:
+        mixed = {k: float(v[0]) if k in scalars[kind] else v for k, v in c.items()}
+        return lambda: impactsym.solve_batch(mixed)
+    if kind == "sweep":
+        grid = {"e": np.linspace(0.0, 0.4, 30), "mu": np.linspace(0.0, 0.6, 30)}
+        return lambda: impactsym.sweep(SCENE_FILE, **grid)
+    if kind == "sample":
+        dists = {"e": ("uniform", 0.0, 0.4), "mu": ("uniform", 0.0, 0.3)}
+        return lambda: impactsym.sample(SCENE_FILE, dists, 5000, seed=1)
+    rows = {k: v[:10_000] for k, v in c.items()}
+    out = impactsym.solve_batch(rows)
+    finals = {k: out[k] for k in ("V1x", "V1y", "W1", "V2x", "V2y", "W2")}
+    if kind == "invert_batch":
+        columns = {**{k: rows[k] for k in ("m1", "m2", "I1", "I2", "r1x", "r1y", "r2x", "r2y",
+                                           "gamma", "e", "mu", "e_m")}, **finals}
+        return lambda: impactsym.invert_batch(columns)
+    if kind == "reconstruct_batch":
+        columns = {**{k: rows[k] for k in ("m1", "m2", "I1", "I2", "w1", "w2", "r1x", "r1y",
+                                           "r2x", "r2y", "gamma")}, **finals,
+                   "theta1": np.arctan2(rows["v1y"], rows["v1x"]),
+                   "theta2": np.arctan2(rows["v2y"], rows["v2x"])}
+        return lambda: impactsym.reconstruct_batch(columns)
+    raise ValueError(f"unknown wait call {kind!r}")
+
+
+def time_compile_waits(columns: dict, quiet: Quiet, runs: int = STARTUP_RUNS) -> dict:
+    """Per WAIT_CALLS kind, in fresh processes: the wait of the very first run (the call
+    never made before; compiles if a driver it needs is not cached) and the least wait
+    over ``runs`` runs. Before them, one solve_batch on ``columns`` in its own process:
+    the package's first use. Also the first use with an empty numba cache (a temporary
+    NUMBA_CACHE_DIR), least of ``runs``."""
+    out = {"calls": {}, "runs": runs}
+    with tempfile.TemporaryDirectory(prefix="impactsym_perf_") as tmp:
+        path = Path(tmp) / "columns.npz"
+        np.savez(path, **columns)
+
+        def child(script, *argv, env=None):
+            done = subprocess.run([sys.executable, "-c", script, *argv], cwd=ROOT, check=True,
+                                  capture_output=True, text=True, env=env)
+            return json.loads(done.stdout.splitlines()[-1])
+
+        child(_FIRST_CALL, str(path))  # the package's first use (warm cache for case (a))
+        for kind in WAIT_CALLS:
+            samples = [quiet.run("3", lambda k=kind: child(_WAIT, k, str(path)))
+                       for _ in range(runs)]
+            waits = [s["first_s"] - s["steady_s"] for s in samples]
+            out["calls"][kind] = {"first_wait_s": waits[0], "min_wait_s": min(waits),
+                                  "steady_s": min(s["steady_s"] for s in samples)}
+        cold = []
+        for _ in range(runs):
+            with tempfile.TemporaryDirectory(prefix="impactsym_numba_") as cache:
+                env = {**os.environ, "NUMBA_CACHE_DIR": cache}
+                cold.append(quiet.run("3", lambda e=env: child(_FIRST_CALL, str(path), env=e)))
+        out["cold_first_call_s"] = min(s["call_s"] for s in cold)
+    return out
 
 
 def _stale_bytecode(path: Path) -> bool:
@@ -531,8 +628,8 @@ def _impactsym_script() -> str:
 
 
 def time_cli_solve(quiet: Quiet, runs: int = STARTUP_RUNS) -> float:
-    """Median wall time of ``impactsym solve SCENE_FILE`` in a fresh process, each run a
-    quiet-gated block (one untimed run first)."""
+    """Least wall time of ``impactsym solve SCENE_FILE`` over ``runs`` fresh processes,
+    each run a quiet-gated block (one untimed run first)."""
     cmd = [_impactsym_script(), "solve", SCENE_FILE]
 
     def once():
@@ -541,12 +638,12 @@ def time_cli_solve(quiet: Quiet, runs: int = STARTUP_RUNS) -> float:
         return time.perf_counter() - t0
 
     once()
-    return statistics.median(quiet.run("3", once) for _ in range(runs))
+    return min(quiet.run("3", once) for _ in range(runs))
 
 
 def time_first_call(columns: dict, quiet: Quiet, runs: int = STARTUP_RUNS) -> dict:
-    """Medians of ``import impactsym`` and of the first solve_batch call on ``columns``,
-    each run in a fresh process (columns loaded from an .npz, untimed) as a quiet-gated
+    """Least times of ``import impactsym`` and of the first solve_batch call on ``columns``
+    (and whether the import alone brought numba in), each run in a fresh process (columns loaded from an .npz, untimed) as a quiet-gated
     block; one untimed run first warms numba's cache."""
     with tempfile.TemporaryDirectory(prefix="impactsym_perf_") as tmp:
         path = Path(tmp) / "columns.npz"
@@ -559,7 +656,9 @@ def time_first_call(columns: dict, quiet: Quiet, runs: int = STARTUP_RUNS) -> di
 
         once()
         samples = [quiet.run("3", once) for _ in range(runs)]
-    return {key: statistics.median(s[key] for s in samples) for key in ("import_s", "call_s")}
+    out = {key: min(s[key] for s in samples) for key in ("import_s", "call_s")}
+    out["numba_on_import"] = any(s["numba_on_import"] for s in samples)
+    return out
 
 
 # ------------------------------------------------------------------ 4. serial threshold
@@ -747,6 +846,15 @@ def targets(cases: dict, simd: dict, base: dict, start: dict, sweep: dict | None
     out.append(Target("batched numpy.linalg.solve, per row vs impactsym (a)",
                       base["stack_ns"] / a.median_ns("real"), 20, True, "×",
                       f"impactsym runs at {a.median_ns('real'):.1f} ns/scene; {angle}"))
+    out.append(Target("`import impactsym`", start["import_s"], 0.5, False, "s",
+                      "numba imported by `import impactsym`" if start["numba_on_import"] else
+                      "numba is not imported; the time is numpy and impactsym's own modules"))
+    for kind, wait in start.get("waits", {}).get("calls", {}).items():
+        out.append(Target(f"compile wait of a call never made before after first use, {kind}",
+                          wait["first_wait_s"], 1.0, False, "s",
+                          "a driver it needs (another kernel, or the other form of the same "
+                          "kernel) was not compiled by the first use; it compiles once per "
+                          "machine"))
     out.append(Target("`impactsym solve` wall time", start["cli_s"], 0.6, False, "s",
                       f"`import impactsym` alone takes {start['import_s']:.2f} s, of which "
                       f"{start['source_compile_s']:.2f} s compile generated/ from source"))
@@ -859,7 +967,7 @@ def markdown(args, code: str, cases: dict, ok: dict, quiet: Quiet, simd: dict, b
               "the row's largest speed. NumPy's solve runs on one core, impactsym on "
               f"{os.cpu_count()}.",
               "",
-              f"## 3. Start-up (fresh processes, median of {STARTUP_RUNS})",
+              f"## 3. Start-up (fresh processes, least of {start['waits']['runs']})",
               "",
               "| what | seconds | target |",
               "|---|---:|---:|",
@@ -867,9 +975,27 @@ def markdown(args, code: str, cases: dict, ok: dict, quiet: Quiet, simd: dict, b
               f"| `import impactsym` | {start['import_s']:.2f} | – |",
               f"| first `solve_batch` call, {n:,} rows, case (a), numba cache warm "
               f"| {start['call_s']:.2f} | ≤ 1 |",
+              f"| first `solve_batch` call, {n:,} rows, case (a), empty numba cache "
+              f"(first use on a machine) | {start['waits']['cold_first_call_s']:.2f} | – |",
+              "",
+              f"`import impactsym` imports numba: {start['numba_on_import']}.",
               "",
               start["bytecode_note"],
               "",
+              "### Compile waits after first use (fresh processes)",
+              "",
+              "The package's first use: one `solve_batch` on case (a) (every column an array, "
+              "an angle per row) in its own process. Then each call below, never made before, "
+              f"in {start['waits']['runs']} fresh processes: wait = first run − second run of the call in the process "
+              "(loading, or compiling, the drivers it needs). *first*: the very first process; "
+              "*min*: least over the processes.",
+              "",
+              "| call | what | first wait s | min wait s | steady s | target |",
+              "|---|---|---:|---:|---:|---:|"]
+    for kind, wait in start["waits"]["calls"].items():
+        lines.append(f"| {kind} | {WAIT_CALLS[kind]} | {wait['first_wait_s']:.2f} "
+                     f"| {wait['min_wait_s']:.2f} | {wait['steady_s']:.3f} | ≤ 1 |")
+    lines += ["",
               "## 4. Serial threshold (rigid, all outputs; median µs per call)",
               "",
               "| n | serial | parallel | run_batch serial | run_batch parallel |",
@@ -939,6 +1065,8 @@ def command(args) -> str:
     if args.sweep is not None:
         parts.append("--sweep" if args.sweep else "--no-sweep")
     parts.append(f"--sweep-points {args.sweep_points}")
+    if args.quick:
+        parts.append("--quick")
     return "python -m benchmarks performance " + " ".join(parts)
 
 
@@ -964,6 +1092,9 @@ def add_arguments(parser) -> None:
                              "of the CPUs (default 0.10)")
     parser.add_argument("--max-wait", type=float, default=180.0,
                         help="seconds to wait in all for a quiet machine (default 180)")
+    parser.add_argument("--quick", action="store_true",
+                        help="a short run: n <= 2e5, 3 repeats, small baselines, 2 start-up "
+                             "runs, no sweep (a few minutes; for checking, not for the record)")
     parser.add_argument("--out", type=Path, default=RESULTS,
                         help="folder for performance.md and performance.json")
 
@@ -991,6 +1122,9 @@ def main(args) -> int:
     def log(msg):
         print(msg, file=sys.stderr, flush=True)
 
+    if args.quick:
+        args.n, args.repeat, args.loop_rows = min(args.n, 200_000), min(args.repeat, 3), 200
+        args.stack_rows, args.threshold_repeat, args.sweep = 20_000, 31, False
     t_start = time.perf_counter()
     code = code_state()
     quiet = Quiet(max_other=args.max_other, budget_s=args.max_wait)
@@ -1006,8 +1140,10 @@ def main(args) -> int:
     base = {"loop_rows": args.loop_rows, "loop_ns": loop_ns, "loop_agreement": agreement,
             "stack_rows": stack_rows,
             "stack_ns": time_stacked(general, stack_rows, min(args.repeat, 3), quiet)}
-    log("3. start-up ...")
-    start = {"cli_s": time_cli_solve(quiet), **time_first_call(general, quiet)}
+    log("3. start-up and compile waits ...")
+    runs = 2 if args.quick else STARTUP_RUNS
+    start = {"cli_s": time_cli_solve(quiet, runs), **time_first_call(general, quiet, runs),
+             "waits": time_compile_waits(general, quiet, runs)}
     start["bytecode_note"], start["source_compile_s"] = bytecode_note()
     log("4. serial threshold ...")
     table = quiet.run("4", lambda: time_threshold(general, args.threshold_repeat))

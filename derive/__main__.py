@@ -1,14 +1,16 @@
 """`python -m derive`: prove, then regenerate generated/; `--check`: fail if stale.
 
 Emission always runs every proof first and stops at the first failure.
-`--check` re-renders in memory and compares bytes with generated/ (it does not
-re-run the proofs: the files it compares were only written after they passed,
-and the source hash in their header ties them to this derive source).
+`--check` re-renders in memory, compares bytes with generated/ and prints a
+unified diff of every stale file (it does not re-run the proofs: the files it
+compares were only written after they passed, and the source hash in their
+header ties them to this derive source).
 """
 
 from __future__ import annotations
 
 import argparse
+import difflib
 import os
 import sys
 from pathlib import Path
@@ -41,6 +43,7 @@ def render_all() -> dict[str, str]:
         kernels = getattr(mod, "EMITTED", mod.KERNELS)
         files[f"{name}.py"] = emit.render_module(f"{name}.py", doc, kernels, digest,
                                                  data=getattr(mod, "DATA", ()))
+        files[f"{name}_jit.py"] = emit.render_jit_module(f"{name}.py", kernels, digest)
     files["codes.py"] = emit.render_codes(digest)
     files["__init__.py"] = emit.render_init(MODEL_MODULES, digest)
     return files
@@ -58,21 +61,31 @@ def run_proofs() -> bool:
     return ok
 
 
-def stale_files(out: Path) -> list[str]:
-    """Names of generated files that are missing or differ from a fresh render."""
-    return [name for name, text in render_all().items()
-            if not (out / name).exists() or (out / name).read_text() != text]
+def stale_files(out: Path) -> dict[str, str]:
+    """Name → unified diff (committed → fresh render) of every generated file
+    that is missing or differs from a fresh render."""
+    stale = {}
+    for name, text in render_all().items():
+        path = out / name
+        old = path.read_text() if path.exists() else ""
+        if old != text:
+            stale[name] = "".join(difflib.unified_diff(
+                old.splitlines(keepends=True), text.splitlines(keepends=True),
+                fromfile=f"{path} (committed)", tofile=f"{path} (fresh render)"))
+    return stale
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m derive", description=__doc__.splitlines()[0])
-    parser.add_argument("--check", action="store_true", help="exit 1 if generated/ is stale")
+    parser.add_argument("--check", action="store_true", help="print a diff and exit 1 if generated/ is stale")
     parser.add_argument("--out", type=Path, default=ROOT / "generated",
                         help="output folder (default: generated/)")
     args = parser.parse_args(argv)
     if args.check:
         stale = stale_files(args.out)
         if stale:
+            for diff in stale.values():
+                sys.stdout.write(diff)
             print(f"generated/ is stale: {', '.join(stale)}; run `python -m derive`")
             return 1
         print("generated/ is up to date")

@@ -101,7 +101,8 @@ def physics_flags(energy_parts, work_terms, mu_used=mu_used):
     more than ROUNDING·|μ_c|.
     """
     tolerances = Block(((tol_energy, ROUNDING * sum(sp.Abs(a * b) for a, b in work_terms)),
-                        (tol_mu, ROUNDING * sp.Abs(mu_c))))
+                        (tol_mu, ROUNDING * sp.Abs(mu_c))),
+                       equation="tolerances of the physics flags (conventions.md)")
     return tolerances, (
         ("ENERGY_CREATED", tuple(sp.StrictLessThan(part, -tol_energy) for part in energy_parts)),
         ("TENSILE_IMPULSE", (sp.GreaterThan(Pn, 0),)),

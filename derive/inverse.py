@@ -106,7 +106,9 @@ def _particle_blocks():
               _separating_guard()),
         Block(((Pn, -(1 + e) * Gn / (e * kk)),)),
         Block(((Pt, mu * Pn),)),
-        Block(((Px, px), (Py, py), (gn, gn_), (gt, Gt + kk * Pt))),
+        # gn = -Gn/e < 0, unless it underflows (e huge): mu_c divides by it.
+        Block(((Px, px), (Py, py), (gn, gn_), (gt, Gt + kk * Pt)),
+              Guard((sp.StrictLessThan(gn, 0),), "NOT_APPROACHING")),
         Block(((v1x, V1x - k1 * Px), (v1y, V1y - k1 * Py), (v2x, V2x + k2 * Px),
                (v2y, V2y + k2 * Py), (TLn, Pn * sp.factor(gn_ + Gn) / 2),
                (TLt, Pt * (gt + Gt) / 2), (mu_c, gt / ((1 + e) * gn)))),

@@ -2,8 +2,9 @@
 
 A kernel is a straight-line program. Its blocks are evaluated in order; every
 formula in a block may use the kernel inputs and the symbols assigned by earlier
-blocks, never a symbol of its own block (the emitter eliminates common
-subexpressions inside a block, so that rule keeps temporaries in order). A block
+blocks, never a symbol of its own block (the emitter places each common
+subexpression at the start of the first block that uses it, so that rule keeps
+temporaries in order). A block
 may end with a guard: a condition that must hold for the row to go on, and the
 status the row gets when it does not. Guards sit before the divisions and
 transcendental calls they protect, so the plain-Python twin of a kernel never
@@ -34,10 +35,12 @@ class Guard:
 
 @dataclass(frozen=True)
 class Block:
-    """Assignments evaluated together (CSE runs over the block), then a guard."""
+    """Assignments evaluated together, then a guard. `equation` names what the
+    block implements (a seed equation, conventions.md), for the emitted comment."""
 
     assigns: tuple[tuple[sp.Symbol, sp.Expr], ...]
     guard: Guard | None = None
+    equation: str = ""
 
 
 @dataclass(frozen=True)

@@ -89,9 +89,14 @@ def _kernel_blocks(sticking: bool):
             + f.normal_components()
             + ((dvx, v2x - v1x), (dvy, v2y - v1y)),
             Guard((sp.StrictGreaterThan(k1 + k2, 0),), "SINGULAR"),
+            equation="conventions.md frame: k = 1/m, n = (cos gamma, sin gamma)",
         ),
-        Block(((gn, gn_), (gt, gt_), (mbar, 1 / (k1 + k2))), f.approach_guard()),
-        Block(((dgn, -(1 + e) * gn), (dgt, dgt_))),
+        Block(((gn, gn_), (gt, gt_), (mbar, 1 / (k1 + k2))), f.approach_guard(),
+              equation="approach in the impact frame (seed Fig. 1); reduced mass (seed eq 17)"),
+        # e = -1 (or an underflowing product) gives no normal impulse: mu_c divides by dgn.
+        Block(((dgn, -(1 + e) * gn), (dgt, dgt_)), Guard((sp.Ne(dgn, 0),), "SINGULAR"),
+              equation="restitution (seed eq 3); " + ("end of sliding (seed eq 8)" if sticking
+                                                      else "impulse ratio (seed eq 5)")),
         Block(
             (
                 # Δ(v2 - v1) = -(1/m1 + 1/m2)·P, so P = -m̄·Δg (eqs 4, 6).
@@ -99,7 +104,8 @@ def _kernel_blocks(sticking: bool):
                 (Pt, -mbar * dgt),
                 (mu_c, -gt / dgn),  # eq 18: μ_max = r/(1 + e)
                 (mu_used, -gt / dgn if sticking else mu),
-            )
+            ),
+            equation="impulses (seed eqs 4, 6); mu_max (seed eq 18)",
         ),
         Block(
             (
@@ -111,7 +117,8 @@ def _kernel_blocks(sticking: bool):
                 # nearly opposite velocities when e is close to 1.
                 (TLn, Pn * sp.factor(gn + gn_final) / 2),
                 (TLt, Pt * (gt + gt_final) / 2),
-            )
+            ),
+            equation="P in the scene frame; work of Pn, Pt (seed eqs 21-26)",
         ),
         Block(
             (
@@ -120,7 +127,8 @@ def _kernel_blocks(sticking: bool):
                 (V2x, v2x - k2 * Px),
                 (V2y, v2y - k2 * Py),
                 (TL, TLn + TLt),
-            )
+            ),
+            equation="final velocities (seed eqs 10-15); TL (seed eq 16)",
         ),
     )
 

@@ -90,15 +90,19 @@ def _frame_blocks():
                (drx, r1x - r2x), (dry, r1y - r2y), (r12, r1x * r2y - r1y * r2x)),
             Guard((sp.StrictGreaterThan(k1 + k2, 0), sp.StrictGreaterThan(j1 + j2, 0)),
                   "SINGULAR"),
+            equation="conventions.md frame: k = 1/m, j = 1/I, n = (cos gamma, sin gamma)",
         ),
         Block(((r1n, r1n_), (r1t, r1t_), (r2n, r2n_), (r2t, r2t_), (gx, gx_), (gy, gy_),
-               (drn, drn_), (drt, drt_), (kk, k1 + k2), (jbar, j1 * j2 / (j1 + j2)))),
+               (drn, drn_), (drt, drt_), (kk, k1 + k2), (jbar, j1 * j2 / (j1 + j2))),
+              equation="arms in the impact frame; u2 - u1 at the impact centre, u_i = v_i + w_i z x r_i"),
         Block(
             ((gn, gn_), (gt, gt_), (Cnm, C[0, 2]), (Ctm, C[1, 2]),
              # 1 - e_m kept as one factor: e_m = 1 gives exactly no moment impulse.
              (am, (1 - e_m) / C[2, 2]),
              (wa, e_m * j1), (wb, e_m * j2), (wc, (1 - e_m) * jbar)),
             f.approach_guard(),
+            equation="compliance C from impulse-momentum (six equations 1, 2); "
+                     "moment restitution (six equations 5)",
         ),
     )
 
@@ -166,12 +170,17 @@ def _impulse_blocks(sticking: bool):
     else:
         denom, pn, pt = (D, Knn + mu * Knt), bn / D, mu * bn / D
     return (
-        Block(tuple(keff.items()) + ((dgn, -(1 + e) * gn),)),
-        Block(((bn, -(dgn + hn)), (bt, gt - ht))),
+        Block(tuple(keff.items()) + ((dgn, -(1 + e) * gn),),
+              equation="effective compliance K (M eliminated); restitution (seed eq 3, "
+                       "six equations 3)"),
+        Block(((bn, -(dgn + hn)), (bt, gt - ht)), equation="K (Pn, Pt) = (bn, bt)"),
         Block((denom, (Dc, pn_c)),
-              Guard((sp.Ne(D, 0), sp.Ne(Dc, 0)), "SINGULAR")),
+              Guard((sp.Ne(D, 0), sp.Ne(Dc, 0)), "SINGULAR"),
+              equation=("no sliding at separation (seed eq 8)" if sticking else
+                        "impulse ratio Pt = mu Pn (seed eq 5, six equations 4)")),
         # μ_c: the ratio Pt/Pn of the sticking solution (det K cancels).
-        Block(((mu_c, pt_c / Dc), (Pn, pn), (Pt, pt))),
+        Block(((mu_c, pt_c / Dc), (Pn, pn), (Pt, pt)),
+              equation="impulses; mu_c, the seed's mu_max (eq 18) generalised"),
     )
 
 
@@ -221,7 +230,8 @@ def _final_blocks(sticking: bool):
                 # (gn + Gn) with Gn = -e·gn factors to (1 - e)·gn (see particle).
                 (TLn, Pn * sp.factor(gn - e * gn) / 2),
                 (TLt, Pt * (gt + gt_final) / 2),
-            )
+            ),
+            equation="P in the scene frame; dV = |P|/m; work of Pn, Pt (seed eqs 21-26)",
         ),
         Block(
             (
@@ -230,16 +240,18 @@ def _final_blocks(sticking: bool):
                 (V1x, v1x + k1 * Px), (V1y, v1y + k1 * Py),
                 (V2x, v2x - k2 * Px), (V2y, v2y - k2 * Py),
                 (W1, w1 + dw1), (W2, w2 + dw2),
-            )
+            ),
+            equation="final velocities from impulse-momentum (six equations 1, 2)",
         ),
         Block(
             (
                 (M, am * s),
                 # W2 - W1 = e_m·s at separation.
                 (TLm, am * s * (wr + e_m * s) / 2),
-            )
+            ),
+            equation="moment impulse (six equations 5) and its work",
         ),
-        Block(((TL, TLn + TLt + TLm),)),
+        Block(((TL, TLn + TLt + TLm),), equation="TL = TLn + TLt + TLm (conventions.md energy)"),
     )
 
 

@@ -25,7 +25,7 @@ from dataclasses import replace
 import sympy as sp
 
 from .frame import gamma, nx, ny
-from .kernel import Block, Guard, IsFinite, Kernel, NotNaN
+from .kernel import Guard, IsFinite, Kernel, NotNaN
 
 # Output tiers of the forward kernels: each adds to the one before.
 TIER_VELOCITIES = ("V1x", "V1y", "W1", "V2x", "V2y", "W2")
@@ -42,7 +42,7 @@ def normal_form(kernel: Kernel) -> Kernel:
     at = kernel.inputs.index(gamma)
     inputs = kernel.inputs[:at] + (nx, ny) + kernel.inputs[at + 1:]
     checks = tuple(_replace_angle_check(g) for g in kernel.checks)
-    blocks = tuple(Block(tuple((s, x) for s, x in b.assigns if s not in (nx, ny)), b.guard)
+    blocks = tuple(replace(b, assigns=tuple((s, x) for s, x in b.assigns if s not in (nx, ny)))
                    for b in kernel.blocks)
     return replace(kernel, inputs=inputs, checks=checks, blocks=blocks, angle=gamma)
 
@@ -73,7 +73,8 @@ def fix_inputs(kernel: Kernel, name: str, values: dict, doc: str) -> Kernel:
                 known[sym] = value
             else:
                 assigns.append((sym, value))
-        blocks.append(Block(tuple(assigns), _fixed_guard(block.guard, known)))
+        blocks.append(replace(block, assigns=tuple(assigns),
+                              guard=_fixed_guard(block.guard, known)))
     outputs = tuple(s for s in kernel.outputs if s not in known)
     constants = kernel.constants + tuple(
         (kernel.public_name(s), float(known[s])) for s in kernel.outputs if s in known)
@@ -127,7 +128,7 @@ def prune(kernel: Kernel, name: str, outputs: tuple[str, ...], doc: str = "") ->
         for _, expr in assigns:
             needed |= expr.free_symbols
         if assigns or block.guard is not None:
-            blocks.append(Block(assigns, block.guard))
+            blocks.append(replace(block, assigns=assigns))
     computed = {s for b in blocks for s, _ in b.assigns}
     return replace(
         kernel, name=name, doc=f"{kernel.doc} {doc}".rstrip(), blocks=tuple(reversed(blocks)),

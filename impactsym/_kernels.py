@@ -1,18 +1,31 @@
-"""The runtime's door to generated/: which kernel serves which scene.
+"""The runtime's one door into generated/: which kernel serves which scene.
 
-A single scene runs the kernel's plain-Python twin (`.py_func`): the same
-generated code, with no JIT compile. Batches run the numba drivers: the serial
-twin below `SERIAL_BELOW` rows (a `prange` launch costs more than it saves),
-the parallel one above.
+Only this module imports `generated`. A single scene runs the kernel's
+per-scene function from the plain module ``generated/<model>.py`` (no numba
+import, nothing compiles). Batches run the numba drivers of
+``generated/<model>_jit.py``, imported on the first batch call: the serial one
+below `SERIAL_BELOW` rows (a `prange` launch costs more than it saves), the
+parallel one above. Every driver argument is a C-contiguous float64 array, so
+each driver compiles once per machine (numba's on-disk cache) whatever mix of
+scalar and array columns a caller gives: a scalar column becomes a filled
+array, reused chunk after chunk (`FILL_BYTES`).
 """
 
 from __future__ import annotations
 
+import importlib
 import math
+import os
+import sys
+import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
+from pathlib import Path
 
-import generated
+try:  # an installed wheel maps generated/ into the package
+    from . import _generated as generated
+except ImportError:  # a checkout (or editable install): generated/ at the top
+    import generated
 
 if getattr(generated, "IMPACTSYM_GENERATED", None) != "impactsym":
     raise ImportError(
@@ -20,12 +33,24 @@ if getattr(generated, "IMPACTSYM_GENERATED", None) != "impactsym":
         "impactsym's generated kernels (another package named 'generated' shadows it)"
     )
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from generated import (  # noqa: E402
-    crash3, delta_v, inverse, particle, planar, presets, reconstruct, report,
-)
-from generated.presets import COEFFICIENT_INPUTS, PRESETS  # noqa: E402
+
+def _generated(name: str):
+    """generated/<name>.py (plain Python, or numba for a *_jit module)."""
+    return importlib.import_module(f"{generated.__name__}.{name}")
+
+
+crash3, delta_v, inverse, particle, planar, presets, reconstruct, report = (
+    _generated(name) for name in ("crash3", "delta_v", "inverse", "particle", "planar",
+                                  "presets", "reconstruct", "report"))
+CODES = _generated("codes")
+PRESETS = presets.PRESETS
+COEFFICIENT_INPUTS = presets.COEFFICIENT_INPUTS
+
+STATUS_NOT_APPROACHING = CODES.STATUS_NOT_APPROACHING
+STATUS_PDOF_BEYOND_LIMIT = CODES.STATUS_PDOF_BEYOND_LIMIT
+FLAG_PDOF_CAPPED = CODES.FLAG_PDOF_CAPPED
 
 SERIAL_BELOW = 64
 
@@ -60,43 +85,98 @@ def requested_outputs(outputs) -> tuple[tuple[str, ...], str]:
     return names, tier
 
 
+# Scalar columns become filled arrays of at most FILL_BYTES together (and at
+# least MIN_CHUNK rows), reused chunk after chunk. Few large chunks: on a busy
+# machine every parallel call waits for its threads to be scheduled.
+FILL_BYTES = 64 << 20
+MIN_CHUNK = 1 << 16
+
+# Seconds a driver may compile before the user is told why the call waits.
+COMPILE_NOTICE_AFTER = 2.0
+
+
+def _set_numba_cache_dir() -> None:
+    """A read-only install (generated/ not writable) caches compiled drivers
+    in the user's cache directory; NUMBA_CACHE_DIR, when set, wins. Numba
+    reads the variable when it is first imported, so this runs before that."""
+    if "NUMBA_CACHE_DIR" in os.environ or "numba" in sys.modules:
+        return
+    here = Path(generated.__file__).resolve().parent
+    if not os.access(here, os.W_OK):
+        base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+        os.environ["NUMBA_CACHE_DIR"] = str(Path(base) / "impactsym" / "numba")
+
+
+_JIT_MODULES: dict = {}
+
+
+def _jit_module(model: str):
+    """generated/<model>_jit.py, imported (with numba) on first use."""
+    if model not in _JIT_MODULES:
+        _set_numba_cache_dir()
+        _JIT_MODULES[model] = _generated(f"{model}_jit")
+    return _JIT_MODULES[model]
+
+
 @dataclass(frozen=True)
 class KernelSet:
-    """One generated kernel: per-scene function, batch drivers, names.
+    """One generated kernel: its MANIFEST row, per-scene function and drivers.
 
     `inputs` are the batch columns, `outputs` the computed outputs and
     `constants` the outputs the kernel fixes to a number (e_m = 1: M = 0).
     A kernel in normal form (`arguments` not None) takes the normal's
-    components (nx, ny) in place of `gamma`: `unit_normal` forms them, and
-    `batch_normal`/`serial_normal` are its drivers that take them as given."""
+    components (nx, ny) in place of `angle`: `unit_normal` forms them, and
+    `batch_normal`/`serial_normal` are its drivers that take them as given.
+    `scene` and `unit_normal` are plain Python; the drivers are numba
+    dispatchers, imported on first access."""
 
+    name: str
+    model: str
     scene: Callable
-    batch: Callable
-    serial: Callable
     inputs: tuple[str, ...]
     outputs: tuple[str, ...]
     constants: dict = field(default_factory=dict)
     arguments: tuple[str, ...] | None = None
-    batch_normal: Callable | None = None
-    serial_normal: Callable | None = None
+    angle: str | None = None
     unit_normal: Callable | None = None
+    operations: int = 0
+
+    def driver(self, parallel: bool, normal: bool = False):
+        """The numba driver: parallel or serial, taking the angle or (nx, ny)."""
+        suffix = ("_normal" if normal else "") + ("" if parallel else "_serial")
+        return getattr(_jit_module(self.model), f"{self.name}_batch{suffix}")
+
+    @property
+    def batch(self):
+        return self.driver(True)
+
+    @property
+    def serial(self):
+        return self.driver(False)
+
+    @property
+    def batch_normal(self):
+        return self.driver(True, True) if self.angle else None
+
+    @property
+    def serial_normal(self):
+        return self.driver(False, True) if self.angle else None
 
 
 def _kernel_set(module, name: str) -> KernelSet:
-    upper = name.upper()
-    arguments = getattr(module, f"{upper}_ARGUMENTS", None)
-    normal = arguments is not None
+    row = module.MANIFEST[name]
+    angle = row["angle"]
     return KernelSet(
+        name=name,
+        model=module.__name__.rsplit(".", 1)[-1],
         scene=getattr(module, name),
-        batch=getattr(module, f"{name}_batch"),
-        serial=getattr(module, f"{name}_batch_serial"),
-        inputs=getattr(module, f"{upper}_INPUTS"),
-        outputs=getattr(module, f"{upper}_OUTPUTS"),
-        constants=getattr(module, f"{upper}_CONSTANTS", {}),
-        arguments=arguments,
-        batch_normal=getattr(module, f"{name}_batch_normal") if normal else None,
-        serial_normal=getattr(module, f"{name}_batch_normal_serial") if normal else None,
-        unit_normal=module.unit_normal if normal else None,
+        inputs=row["columns"],
+        outputs=row["outputs"],
+        constants=row["constants"],
+        arguments=row["arguments"] if angle else None,
+        angle=angle,
+        unit_normal=module.unit_normal if angle else None,
+        operations=row["operations"],
     )
 
 
@@ -177,11 +257,67 @@ def inverse_kernel_for(model: str) -> KernelSet:
 
 
 def _as_input(value):
-    """A batch input as the drivers take it: a float scalar (the same for every
-    row) or a C-contiguous float64 array (one value per row)."""
+    """A batch input: a float scalar (the same for every row) or a
+    C-contiguous float64 array (one value per row)."""
     if np.ndim(value) == 0:
         return float(value)
     return np.ascontiguousarray(value, dtype=np.float64)
+
+
+def _columns_for(ks: KernelSet, inputs: list, n: int) -> tuple[list, bool]:
+    """The driver's columns (scalars still scalars) and whether the normal
+    form runs. One angle for every row: its normal once (`unit_normal`), not
+    per row. Per-row angles within SINCOS_LIMIT: the angle driver (`_sincos`
+    per row). Otherwise NumPy's cos/sin give the normal for the batch."""
+    if ks.angle is None:
+        return inputs, False
+    at = ks.inputs.index(ks.angle)
+    angle = inputs[at]
+    if not isinstance(angle, np.ndarray):
+        return inputs[:at] + list(ks.unit_normal(angle)) + inputs[at + 1:], True
+    limit = _generated(ks.model).SINCOS_LIMIT
+    if np.any(np.isfinite(angle) & (np.abs(angle) > limit)):
+        with np.errstate(invalid="ignore"):
+            normal = [np.cos(angle), np.sin(angle)]
+        return inputs[:at] + normal + inputs[at + 1:], True
+    return inputs, False
+
+
+def _compile_notice(ks: KernelSet, driver, parallel: bool):
+    """A timer that says, after COMPILE_NOTICE_AFTER seconds, that the call
+    waits for numba (once per machine); None when the driver is compiled."""
+    if driver.signatures:
+        return None
+    seconds = max(2, round(ks.operations / (20 if parallel else 35)))
+    message = (f"impactsym: compiling the {ks.name} batch kernel for this machine "
+               f"(once; about {seconds} s)")
+    timer = threading.Timer(COMPILE_NOTICE_AFTER, print, (message,), {"file": sys.stderr})
+    timer.daemon = True
+    timer.start()
+    return timer
+
+
+def _call(ks: KernelSet, driver, parallel: bool, columns: list, outs: list) -> None:
+    """Run `driver` over all rows; scalar columns become filled arrays, a
+    chunk of rows at a time (every argument a C-contiguous float64 array, so
+    the driver has one compiled signature)."""
+    n = outs[-1].shape[0]
+    timer = _compile_notice(ks, driver, parallel)
+    try:
+        if all(isinstance(c, np.ndarray) for c in columns):
+            driver(*columns, *outs)
+            return
+        scalars = sum(not isinstance(c, np.ndarray) for c in columns)
+        size = min(n, max(MIN_CHUNK, FILL_BYTES // (8 * scalars)))
+        fills = [None if isinstance(c, np.ndarray) else np.full(size, c) for c in columns]
+        for start in range(0, n, size):
+            stop = min(start + size, n)
+            args = [c[start:stop] if f is None else f[:stop - start]
+                    for c, f in zip(columns, fills)]
+            driver(*args, *(o[start:stop] for o in outs))
+    finally:
+        if timer is not None:
+            timer.cancel()
 
 
 def run_batch(ks: KernelSet, inputs: list, n: int | None = None) -> tuple[dict, np.ndarray, np.ndarray]:
@@ -189,36 +325,33 @@ def run_batch(ks: KernelSet, inputs: list, n: int | None = None) -> tuple[dict, 
     float64 array of the batch length or a scalar for every row) and return
     (computed outputs by name, status, flags) in freshly allocated arrays.
 
-    A kernel in normal form with one angle for every row gets the normal's
-    components once, not per row. Below `SERIAL_BELOW` rows the serial twin
-    runs (a parallel launch costs more than it saves)."""
+    Below `SERIAL_BELOW` rows the serial driver runs (a parallel launch costs
+    more than it saves)."""
     inputs = [_as_input(x) for x in inputs]
     if n is None:
         n = max((x.shape[0] for x in inputs if isinstance(x, np.ndarray)), default=1)
     outs = {name: np.empty(n) for name in ks.outputs}
     status = np.empty(n, dtype=np.int32)
     flags = np.empty(n, dtype=np.int32)
-    serial = n < SERIAL_BELOW
-    driver = ks.serial if serial else ks.batch
-    if ks.arguments is not None:
-        at = ks.inputs.index("gamma")
-        if not isinstance(inputs[at], np.ndarray):
-            inputs[at:at + 1] = ks.unit_normal.py_func(inputs[at])
-            driver = ks.serial_normal if serial else ks.batch_normal
-    driver(*inputs, *outs.values(), status, flags)
+    if n == 0:
+        return outs, status, flags
+    columns, normal = _columns_for(ks, inputs, n)
+    parallel = n >= SERIAL_BELOW
+    _call(ks, ks.driver(parallel, normal), parallel, columns, [*outs.values(), status, flags])
     return outs, status, flags
 
 
 def run_one(ks: KernelSet, values: dict, outputs: tuple[str, ...]) -> dict:
-    """Run one scene through a kernel's plain-Python twin (no compile).
+    """Run one scene through a kernel's per-scene function (plain Python: no
+    numba, no compile).
 
     Returns every name of `outputs` (0.0 for a quantity the kernel's model does
     not have, NaN on a failed row) plus int `status` and `flags`."""
     args = [float(values[name]) for name in ks.inputs]
     if ks.arguments is not None:
-        at = ks.inputs.index("gamma")
-        args[at:at + 1] = ks.unit_normal.py_func(args[at])
-    *outs, status, flags = ks.scene.py_func(*args)
+        at = ks.inputs.index(ks.angle)
+        args[at:at + 1] = ks.unit_normal(args[at])
+    *outs, status, flags = ks.scene(*args)
     result = dict(zip(ks.outputs, outs))
     for name in outputs:
         if name not in result:

@@ -48,7 +48,7 @@ flag   meaning (bits add up)
 
 from __future__ import annotations
 
-from generated import codes as _codes
+from ._kernels import CODES as _codes
 
 STATUS_OK = _codes.STATUS_OK
 FLAG_ENERGY_CREATED = _codes.FLAG_ENERGY_CREATED

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Union
 
-from generated.presets import PRESETS
+from ._kernels import PRESETS
 
 from . import _kernels
 from ._util import require

@@ -72,9 +72,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Union
 
-from generated.codes import FLAG_PDOF_CAPPED
 
 from . import _kernels
+from ._kernels import FLAG_PDOF_CAPPED
 from .casefile import check_keys
 from .codes import describe_status
 from .crash3_tables import CLASSES, FACES, class_dimensions, stiffness

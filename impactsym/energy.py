@@ -30,7 +30,7 @@ def delta_v_from_energy(TL, m1, m2, *, e=0.0, mu=0.0, r=0.0, gamma=0.0,
                 gamma=gamma, e=e, mu=mu, r=r, TL=TL)
     ks = _kernels.DELTA_V
     if all(np.ndim(v) == 0 for v in args.values()):
-        *outs, status, _ = ks.scene.py_func(*[float(args[k]) for k in ks.inputs])
+        *outs, status, _ = ks.scene(*[float(args[k]) for k in ks.inputs])
         if status:
             raise ValueError(f"delta_v_from_energy: {describe_status(status)}")
         return dict(zip(ks.outputs, outs))

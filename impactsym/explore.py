@@ -82,7 +82,7 @@ class Explorer:
         else:
             self.name = "scene"
         self.base = self.scene.to_dict()
-        from generated.presets import PRESETS
+        from ._kernels import PRESETS
 
         preset = PRESETS[self.scene.model]
         self.used = tuple(key for key in _COEFFICIENTS

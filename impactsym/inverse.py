@@ -12,9 +12,8 @@ import math
 from collections.abc import Mapping
 from pathlib import Path
 
-from generated.codes import STATUS_NOT_APPROACHING
-
 from . import _kernels
+from ._kernels import STATUS_NOT_APPROACHING
 from .batch import run_columns
 from .codes import describe_flags, describe_status
 from .result import Result, VehicleResult, scene_warnings

@@ -5,9 +5,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 
-from generated.codes import STATUS_NOT_APPROACHING
-
 from . import _kernels
+from ._kernels import STATUS_NOT_APPROACHING
 from .codes import describe_status
 from .result import Result
 from .scene import Scene, SceneError, load_scene

@@ -16,8 +16,6 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
-import pytest
-
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "impactsym"
 DOOR = "impactsym._kernels"
@@ -115,6 +113,5 @@ def test_the_runtime_never_imports_sympy_or_derive():
     assert _importers(("sympy", "derive")) == {}
 
 
-@pytest.mark.xfail(strict=True, reason="until wt-emit merges: today 7 more modules import generated")
 def test_only_the_door_imports_generated_code():
     assert set(_importers(GENERATED)) == {DOOR}

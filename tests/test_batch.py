@@ -95,9 +95,88 @@ def test_column_errors_name_the_column():
 
 
 def test_a_single_scene_compiles_nothing():
-    code = ("import impactsym, generated.planar as p; "
+    """A single scene runs the plain per-scene function: numba is never imported."""
+    code = ("import sys, impactsym; "
             "impactsym.solve('examples/two_car_us.json'); "
-            "assert p.rigid.signatures == [] and p.rigid_batch.signatures == [], 'compiled'")
+            "assert 'numba' not in sys.modules, 'numba imported'")
     proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
                           text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
+
+
+def test_any_mix_of_scalars_and_arrays_uses_one_compiled_signature():
+    """Scalar columns become filled arrays: whatever the mix, each driver sees
+    C-contiguous float64 arrays only (one signature), and the rows agree bitwise."""
+    from impactsym import _kernels
+
+    c = _rigid(300, seed=5)
+    ks = _kernels.kernel_for("rigid", False)
+    reference = impactsym.solve_batch(c)
+    for scalars in (("m1", "m2", "I1", "I2"), ("e", "mu", "e_m"), ("r1x", "w2")):
+        mixed = {k: (float(v[0]) if k in scalars else v) for k, v in c.items()}
+        same = {k: (np.full(300, v[0]) if k in scalars else v) for k, v in c.items()}
+        out, want = impactsym.solve_batch(mixed), impactsym.solve_batch(same)
+        for name in OUTPUTS:
+            np.testing.assert_array_equal(out[name], want[name], err_msg=f"{scalars} {name}")
+    assert (reference["status"] == 0).all()
+    assert len(ks.batch.signatures) == 1
+
+
+def test_scalars_are_filled_chunk_by_chunk(monkeypatch):
+    """A batch longer than a chunk with scalar columns gives the rows a single
+    call would give (each chunk its own slice of the outputs)."""
+    from impactsym import _kernels
+
+    c = _rigid(250, seed=6)
+    mixed = {k: (float(v[0]) if k in ("m1", "e") else v) for k, v in c.items()}
+    whole = impactsym.solve_batch(mixed)
+    monkeypatch.setattr(_kernels, "FILL_BYTES", 8 * 2 * 64)  # two scalars: 64-row chunks
+    monkeypatch.setattr(_kernels, "MIN_CHUNK", 64)
+    chunked = impactsym.solve_batch(mixed)
+    for name in (*OUTPUTS, "status", "flags"):
+        np.testing.assert_array_equal(chunked[name], whole[name], err_msg=name)
+
+
+def test_a_slow_first_compile_says_so(monkeypatch, capsys):
+    """A driver without a compiled signature that takes longer than
+    COMPILE_NOTICE_AFTER prints one line to stderr; a compiled one prints nothing."""
+    import time
+
+    from impactsym import _kernels
+
+    class Driver:
+        def __init__(self, signatures):
+            self.signatures = signatures
+
+        def __call__(self, *args):
+            time.sleep(0.3)
+
+    monkeypatch.setattr(_kernels, "COMPILE_NOTICE_AFTER", 0.05)
+    ks = _kernels.kernel_for("rigid", False)
+    outs = [np.empty(3), np.empty(3, dtype=np.int32)]
+    _kernels._call(ks, Driver([]), True, [np.zeros(3)], outs)
+    _kernels._call(ks, Driver(["compiled"]), True, [np.zeros(3)], outs)
+    err = capsys.readouterr().err.splitlines()
+    assert err == [err[0]] and err[0].startswith("impactsym: compiling the rigid batch kernel "
+                                                 "for this machine (once; about ")
+
+
+def test_a_read_only_install_caches_compiled_drivers_in_the_user_directory(tmp_path):
+    """generated/ not writable and NUMBA_CACHE_DIR unset: the drivers are cached
+    under $XDG_CACHE_HOME/impactsym/numba, and a batch runs."""
+    code = ("import os; real = os.access; "
+            "os.access = lambda p, m, **k: False if m == os.W_OK else real(p, m, **k); "
+            "import impactsym; "
+            "out = impactsym.solve_batch({'m1': [1500.0], 'm2': [1200.0], 'v1x': [20.0], "
+            "'v1y': [0.0], 'v2x': [0.0], 'v2y': [0.0], 'gamma': 0.0, 'e': 0.2, 'mu': 0.1}, "
+            "model='particle'); "
+            "assert out['status'][0] == 0, out; "
+            "import numba.core.config as cfg; print(cfg.CACHE_DIR)")
+    env = {k: v for k, v in __import__("os").environ.items() if k != "NUMBA_CACHE_DIR"}
+    env["XDG_CACHE_HOME"] = str(tmp_path)
+    proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
+                          text=True, timeout=600, env=env)
+    assert proc.returncode == 0, proc.stderr
+    cache = tmp_path / "impactsym" / "numba"
+    assert proc.stdout.strip() == str(cache)
+    assert any(cache.rglob("*.nbi")), "nothing cached in the user directory"

@@ -62,7 +62,6 @@ def test_the_sdist_carries_what_the_tests_read(dists):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="until wt-emit merges and the door imports impactsym._generated")
 def test_the_installed_wheel_solves_with_its_own_generated_code(dists, tmp_path):
     """Installed alone (no checkout on sys.path), the wheel finds its kernels in
     impactsym._generated and solves an example scene."""
