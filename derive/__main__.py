@@ -13,7 +13,8 @@ import os
 import sys
 from pathlib import Path
 
-MODEL_MODULES = ("particle", "planar", "delta_v", "inverse", "reconstruct", "presets", "crash3", "report")
+MODEL_MODULES = ("particle", "planar", "delta_v", "inverse", "reconstruct", "presets", "crash3", "report",
+                 "jacobian")
 ROOT = Path(__file__).resolve().parent.parent
 
 

@@ -23,7 +23,7 @@ if getattr(generated, "IMPACTSYM_GENERATED", None) != "impactsym":
 import numpy as np  # noqa: E402
 
 from generated import (  # noqa: E402
-    crash3, delta_v, inverse, particle, planar, presets, reconstruct, report,
+    crash3, delta_v, inverse, jacobian, particle, planar, presets, reconstruct, report,
 )
 from generated.presets import COEFFICIENT_INPUTS, PRESETS  # noqa: E402
 
@@ -143,6 +143,14 @@ CRASH3_MOMENT_ARM = _kernel_set(crash3, "crash3_moment_arm")
 CRASH3_RADIUS_OF_GYRATION = _kernel_set(crash3, "crash3_radius_of_gyration")
 CRASH3_IMPLIED_PDOF = _kernel_set(crash3, "crash3_implied_pdof")
 KINETIC_ENERGY = _kernel_set(report, "kinetic_energy")
+
+# Exact first derivatives (derive/jacobian.py), by value-kernel name: the value
+# outputs plus d_<output>__d_<input> (angles in radians, inputs as the batch
+# columns, gamma rather than the normal's components).
+JACOBIAN = {name: _kernel_set(jacobian, f"{name}_jacobian") for name in (
+    "rigid", "rigid_critical", "particle", "particle_critical", "rigid_inverse",
+    "particle_inverse", "reconstruct", "crash3_energy_2", "crash3_energy_4", "crash3_energy_6",
+    "crash3_delta_v", "crash3_moment_arm", "crash3_radius_of_gyration")}
 
 
 def _check_model(model: str, models: tuple[str, ...] = MODELS) -> None:
