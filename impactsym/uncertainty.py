@@ -230,6 +230,7 @@ class Command:
     run: Callable
     jacobian_kernel: Callable
     outputs: Callable
+    gradients: Callable | None = None
 
 
 def _forward_command(model: str) -> Command:
@@ -263,8 +264,139 @@ def _split(result: Mapping):
     return outs, np.asarray(result["status"]), np.asarray(result["flags"])
 
 
-def command_for(command: str, model: str = "rigid") -> Command:
-    """The Command of ``solve`` (any model), ``invert`` (rigid, particle) or ``reconstruct``."""
+# --------------------------------------------------------------------------- CRASH3: a chain of kernels
+
+def _crash3_stages(c: Mapping, units: str, e: float, tangents: list | None = None):
+    """CRASH3 over columns `c` (scene_columns' crash3 form): per vehicle the
+    crush-energy kernel, radius of gyration and moment arm, then the delta-V
+    kernel on the total energy. With `tangents` (per input, d column) the
+    exact Jacobian kernels of each stage carry them through too (one scene).
+    Returns (values by name, status, per-input tangents by name)."""
+    from .crash3 import ENERGY_FACTOR
+
+    factor = ENERGY_FACTOR[units]
+    n = max([np.size(v) for k, v in c.items() if k != "crush"] + [
+        np.size(v) for crush in c["crush"] if crush for v in crush.values()])
+    vals, status = {}, np.zeros(n, dtype=np.int32)
+    tan = [dict(t) for t in tangents] if tangents is not None else None
+
+    def stage(name: str, ks, inputs: dict, prefix: str = ""):
+        args = [inputs[k] for k in ks.inputs]
+        if tan is None:
+            outs, st, _fl = _kernels.run_batch(ks, args, n)
+        else:
+            jk = _kernels.JACOBIAN[name]
+            row = _kernels.run_one(jk, {k: float(np.ravel(v)[0]) for k, v in inputs.items()},
+                                   jk.outputs)
+            st = np.array([row["status"]])
+            outs = {o: np.array([row[o]]) for o in ks.outputs}
+            for t in tan:
+                for o in ks.outputs:
+                    t[prefix + o] = sum(row.get(f"d_{o}__d_{x}", 0.0) * t.get(inputs_key[x], 0.0)
+                                        for x in ks.inputs)
+        np.copyto(status, st, where=status == 0)
+        return outs
+
+    for i, crush in enumerate(c["crush"], start=1):
+        if crush is None:
+            vals.update({f"E{i}": 0.0, f"E_crush{i}": 0.0, f"rg{i}": math.inf, f"h{i}": 0.0,
+                         f"alpha{i}": 0.0, f"m{i}": math.inf})
+            continue
+        depths = sum(1 for k in crush if k.startswith("C") and k[1:].isdigit())
+        inputs_key = {k: f"crush{i}.{k}" for k in crush}
+        out = stage(f"crash3_energy_{depths}", _kernels.CRASH3_ENERGY[depths], crush, f"energy{i}.")
+        vals[f"E_crush{i}"], vals[f"E{i}"] = out["E_crush"] * factor, out["E"] * factor
+        vals[f"alpha{i}"], vals[f"m{i}"] = crush["alpha"], c[f"m{i}"]
+        if tan is not None:
+            for t in tan:
+                t[f"E{i}"] = t[f"energy{i}.E"] * factor
+                t[f"E_crush{i}"] = t[f"energy{i}.E_crush"] * factor
+                t[f"alpha{i}"], t[f"m{i}"] = t.get(f"crush{i}.alpha", 0.0), t.get(f"m{i}", 0.0)
+        if "radius_of_gyration" in crush:
+            vals[f"rg{i}"] = crush["radius_of_gyration"]
+            _alias(tan, f"rg{i}", f"crush{i}.radius_of_gyration")
+        elif np.all(np.isfinite(c[f"I{i}"])):
+            inputs_key = {"mass": f"m{i}", "inertia": f"I{i}"}
+            vals[f"rg{i}"] = stage("crash3_radius_of_gyration", _kernels.CRASH3_RADIUS_OF_GYRATION,
+                                   {"mass": c[f"m{i}"], "inertia": c[f"I{i}"]}, f"rg{i}.")["rg"]
+            _alias(tan, f"rg{i}", f"rg{i}.rg")
+        else:
+            vals[f"rg{i}"] = math.inf
+        if "moment_arm" in crush:
+            vals[f"h{i}"] = crush["moment_arm"]
+            _alias(tan, f"h{i}", f"crush{i}.moment_arm")
+        else:
+            theta = c["gamma"] + crush["alpha"]
+            if tan is not None:
+                for t in tan:
+                    t[f"theta{i}"] = t.get("gamma", 0.0) + t.get(f"crush{i}.alpha", 0.0)
+            inputs_key = {"rx": f"r{i}x", "ry": f"r{i}y", "theta": f"theta{i}"}
+            vals[f"h{i}"] = stage("crash3_moment_arm", _kernels.CRASH3_MOMENT_ARM,
+                                  {"rx": c[f"r{i}x"], "ry": c[f"r{i}y"], "theta": theta}, f"h{i}.")["h"]
+            _alias(tan, f"h{i}", f"h{i}.h")
+    vals["E"] = vals["E1"] + vals["E2"]
+    if tan is not None:
+        for t in tan:
+            t["E"] = t.get("E1", 0.0) + t.get("E2", 0.0)
+    inputs_key = {k: k for k in ("m1", "m2", "rg1", "rg2", "h1", "h2", "E", "e", "gamma",
+                                 "alpha1", "alpha2")}
+    dv_inputs = {k: vals[k] if k in vals else c[k] for k in inputs_key if k != "e"}
+    dv_inputs["e"] = e
+    vals.update(stage("crash3_delta_v", _kernels.CRASH3_DELTA_V, dv_inputs, "dv."))
+    if tan is not None:
+        for t in tan:
+            for o in _kernels.CRASH3_DELTA_V.outputs:
+                t[o] = t[f"dv.{o}"]
+    return vals, status, tan
+
+
+def _alias(tangents, name: str, source: str) -> None:
+    if tangents is not None:
+        for t in tangents:
+            t[name] = t.get(source, 0.0)
+
+
+def _crash3_outputs(c: Mapping, v: Mapping) -> dict:
+    out = {}
+    for i in (1, 2):
+        p = f"vehicles[{i - 1}]"
+        out.update({f"{p}.crush_energy": v[f"E{i}"], f"{p}.crush_energy_uncorrected": v[f"E_crush{i}"],
+                    f"{p}.effective_mass_factor": v[f"mass_factor{i}"], f"{p}.moment_arm": v[f"h{i}"],
+                    f"{p}.delta_v[0]": v[f"dV{i}x"], f"{p}.delta_v[1]": v[f"dV{i}y"],
+                    f"{p}.delta_v_magnitude": v[f"dV{i}"]})
+    out["energy_total"], out["impulse"] = v["E"], v["P"]
+    return out
+
+
+def _crash3_command(units: str, e: float) -> Command:
+    """CRASH3 as a chain of kernels; its gradients chain their exact Jacobians."""
+    def run(c):
+        vals, status, _ = _crash3_stages(c, units, e)
+        return vals, status, np.zeros_like(status)
+
+    def gradients(base: dict, dcols: list) -> dict:
+        vals, status, tan = _crash3_stages(base, units, e, dcols)
+        if status[0] != 0:
+            return {}
+        values = _crash3_outputs(base, {k: np.ravel(x)[0] if np.ndim(x) else x for k, x in vals.items()})
+        grads = {path: np.zeros(len(dcols)) for path in values}
+        for j, t in enumerate(tan):
+            h = COMPLEX_STEP
+            cplx = {k: complex(np.ravel(x)[0] if np.ndim(x) else x, h * t.get(k, 0.0))
+                    for k, x in vals.items()}
+            for path, y in _crash3_outputs(base, cplx).items():
+                grads[path][j] = np.imag(y) / h
+        return grads
+
+    return Command("crash3", run, lambda c: (None, {}), _crash3_outputs, gradients)
+
+
+def command_for(command: str, model: str = "rigid", units: str = "SI",
+                restitution: float = 0.0) -> Command:
+    """The Command of ``solve`` (any model), ``invert`` (rigid, particle),
+    ``reconstruct`` or ``crash3`` (scene units and CRASH3's restitution)."""
+    if command == "crash3":
+        return _crash3_command(units, restitution)
     if command == "solve":
         return _forward_command(model)
     if command == "invert":
@@ -498,8 +630,9 @@ def _run_chunk(source: Source, overrides: dict, rejected: dict):
     """Solve one chunk: (accepted mask, output path → values)."""
     columns, reason = source.columns(overrides)
     outs, status, flags = source.command.run(columns)
-    values = source.command.outputs(columns, outs)
     n = status.shape[0]
+    values = {path: np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
+              for path, v in source.command.outputs(columns, outs).items()}
     ok = np.ones(n, dtype=bool)
     reason = np.broadcast_to(np.asarray(reason, dtype=object), (n,))
     bad_leaf = reason != ""
@@ -537,9 +670,21 @@ def _nominal(source: Source) -> dict:
 
 
 def _row(columns: Mapping, i: int) -> dict:
-    """Row i of columns as scalars (strings such as mu = "critical" kept)."""
-    return {k: (v if isinstance(v, str) or np.ndim(v) == 0 else float(np.asarray(v)[i]))
-            for k, v in columns.items()}
+    """Row i of columns as scalars (strings such as mu = "critical" kept;
+    CRASH3's per-vehicle crush tables row by row too)."""
+    def at(v):
+        return v if isinstance(v, str) or np.ndim(v) == 0 else float(np.asarray(v)[i])
+
+    return {k: ([None if t is None else {a: at(b) for a, b in t.items()} for t in v]
+                if k == "crush" else at(v)) for k, v in columns.items()}
+
+
+def _flat(columns: Mapping) -> dict:
+    """Columns with CRASH3's crush tables flattened to ``crush<i>.<name>``."""
+    out = {k: v for k, v in columns.items() if k != "crush"}
+    for i, table in enumerate(columns.get("crush") or (), start=1):
+        out.update({f"crush{i}.{k}": v for k, v in (table or {}).items()})
+    return out
 
 
 def _notes(flags: int, accepted: int, draws: int, rejected: dict) -> list[str]:
@@ -574,6 +719,8 @@ def _gradients(source: Source, nominal: dict) -> dict:
     empty when the command has no Jacobian kernel."""
     command = source.command
     base = nominal["columns"]
+    if command.gradients is not None:
+        return command.gradients(base, _column_derivatives(source, base))
     ks, extra = command.jacobian_kernel(base)
     if ks is None:
         return {}
@@ -619,7 +766,7 @@ def _column_derivatives(source: Source, base: dict) -> list[dict]:
     out = []
     for j in range(k):
         dc = {}
-        for name, col in columns.items():
+        for name, col in _flat(columns).items():
             if isinstance(col, str) or np.ndim(col) == 0:
                 continue
             f = np.asarray(col, dtype=np.float64)[4 * j:4 * j + 4]
