@@ -18,6 +18,7 @@ from typing import Callable
 
 import numpy as np
 
+from . import uncertainty_cli
 from .compare import compare
 from .crash3 import crash3
 from .scene import SceneError
@@ -67,6 +68,7 @@ def _add_solve(parser: argparse.ArgumentParser) -> None:
     ``--plot PATH`` (the scene diagram)."""
     _add_scene(parser)
     add_plot_argument(parser)
+    uncertainty_cli.add_arguments(parser)
 
 
 def _print_result(result, as_json: bool) -> int:
@@ -78,8 +80,11 @@ def _print_result(result, as_json: bool) -> int:
     return 0
 
 
-def _report(result, args: argparse.Namespace) -> int:
-    """Draw the scene diagram (``--plot``), then print the result."""
+def _report(result, args: argparse.Namespace, command: str) -> int:
+    """Draw the scene diagram (``--plot``), then print the result; with
+    ``--uncertainty`` the result with its uncertainty (uncertainty_cli)."""
+    if args.uncertainty:
+        return uncertainty_cli.run(args, command, result)
     if args.plot:
         save_plot(result, args.plot, scene=args.scene)
     return _print_result(result, args.json)
@@ -87,17 +92,17 @@ def _report(result, args: argparse.Namespace) -> int:
 
 def _run_solve(args: argparse.Namespace) -> int:
     """Solve a scene; print JSON (``--json``) or a table."""
-    return _report(solve(args.scene), args)
+    return _report(solve(args.scene), args, "solve")
 
 
 def _run_reconstruct(args: argparse.Namespace) -> int:
     """Reconstruct pre-impact speeds from final motion and headings; print JSON or a table."""
-    return _report(reconstruct(args.scene), args)
+    return _report(reconstruct(args.scene), args, "reconstruct")
 
 
 def _run_invert(args: argparse.Namespace) -> int:
     """Recover the pre-impact motion of an inverse scene; print JSON or a table."""
-    return _report(invert(args.scene), args)
+    return _report(invert(args.scene), args, "invert")
 
 
 def _add_crash3(parser: argparse.ArgumentParser) -> None:
@@ -105,11 +110,15 @@ def _add_crash3(parser: argparse.ArgumentParser) -> None:
     _add_scene(parser)
     parser.add_argument("--restitution", type=float, default=0.0, metavar="E",
                         help="restitution e, 0 <= e < 1 (default 0: CRASH3's common velocity)")
+    uncertainty_cli.add_arguments(parser, plot=True)
 
 
 def _run_crash3(args: argparse.Namespace) -> int:
     """CRASH3 delta-V from the vehicles' crush tables; print JSON or a table."""
-    return _print_result(crash3(args.scene, restitution=args.restitution), args.json)
+    result = crash3(args.scene, restitution=args.restitution)
+    if args.uncertainty:
+        return uncertainty_cli.run(args, "crash3", result, restitution=args.restitution)
+    return _print_result(result, args.json)
 
 
 def _add_compare(parser: argparse.ArgumentParser) -> None:

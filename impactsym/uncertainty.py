@@ -824,13 +824,15 @@ def sobol_indices(source: Source, draws: int, seed, stats: dict) -> dict:
 # --------------------------------------------------------------------------- scenes
 
 def uncertainty(scene, command: str = "solve", draws: int = 10_000, seed: int | None = None,
-                sobol: bool = False) -> Uncertainty:
+                sobol: bool = False, restitution: float = 0.0) -> Uncertainty:
     """Uncertainty of ``command``'s answers for a scene whose leaves carry
-    distributions (see the module docstring and conventions.md, Uncertainty)."""
-    return propagate(scene_source(scene, command), draws=draws, seed=seed, sobol=sobol)
+    distributions (see the module docstring and conventions.md, Uncertainty).
+    ``restitution``: CRASH3's restitution (crash3 only)."""
+    return propagate(scene_source(scene, command, restitution), draws=draws, seed=seed,
+                     sobol=sobol)
 
 
-def scene_source(scene, command: str) -> Source:
+def scene_source(scene, command: str, restitution: float = 0.0) -> Source:
     """The Source of a scene (path, mapping or Scene) for a command."""
     from .scene import load_scene, scene_columns
 
@@ -845,5 +847,5 @@ def scene_source(scene, command: str) -> Source:
         sc = scene_columns(parsed, overrides)
         return sc.columns, sc.reason
 
-    return Source(command_for(command, parsed.model), inputs, columns,
+    return Source(command_for(command, parsed.model, parsed.units, restitution), inputs, columns,
                   tuple(getattr(parsed, "correlations", ())))
