@@ -1,0 +1,130 @@
+"""Uncertainty: Monte Carlo end to end, Jacobian kernels, memory of a long stream.
+
+Three measurements, each as a ratio to a baseline of the same run (the
+machine is shared; absolute times are noisy, ratios less so):
+
+1. ``propagate`` of a reconstruction with eight uncertain inputs, N draws end
+   to end (draws, copula, kernels, rejection, statistics, linear budget),
+   after a first call has compiled everything; baseline: ``reconstruct_batch``
+   alone on N rows of fixed columns.
+2. A Jacobian kernel's parallel batch driver per scene against its value
+   kernel's (reconstruct and rigid), same rows.
+3. Peak resident memory of a child process streaming ``--stream`` draws,
+   against a child streaming 2^18 draws (one chunk).
+
+    python -m benchmarks uncertainty [--draws 1000000] [--stream 100000000]
+"""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+DESCRIPTION = "uncertainty: 1e6-draw reconstruction, Jacobian vs value kernels, streaming memory"
+
+SCENE = dict(m1=1500.0, m2=1200.0, I1=2500.0, I2=2000.0, V1x=13.97, V1y=-1.71, W1=-0.50,
+             V2x=4.70, V2y=9.86, W2=0.45, theta1=0.0, theta2=math.pi / 2, w1=0.0, w2=0.0,
+             r1x=2.0, r1y=0.3, r2x=-0.5, r2y=-2.0, gamma=0.3)
+UNCERTAIN = {"V1x": 0.3, "V1y": 0.3, "V2x": 0.3, "V2y": 0.3, "m1": 30.0, "m2": 30.0,
+             "theta1": 0.02, "theta2": 0.02}
+
+
+def source():
+    """A column-level reconstruction with eight normal inputs (named by column)."""
+    from impactsym import uncertainty as U
+
+    inputs = tuple(U.Input(k, "normal", (SCENE[k], sd)) for k, sd in UNCERTAIN.items())
+
+    def columns(overrides):
+        n = len(next(iter(overrides.values())))
+        return {**SCENE, **overrides}, np.full(n, "")
+
+    return U.Source(U.RECONSTRUCT, inputs, columns)
+
+
+def _best(func, repeat: int = 3) -> float:
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        func()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def end_to_end(draws: int) -> dict:
+    from impactsym import reconstruct_batch
+    from impactsym import uncertainty as U
+
+    src = source()
+    U.propagate(src, draws=1 << 16, seed=1)  # compile and warm up
+    rng = np.random.default_rng(0)
+    cols = {**SCENE, **{k: SCENE[k] + sd * rng.standard_normal(draws) for k, sd in UNCERTAIN.items()}}
+    reconstruct_batch(cols)
+    t_mc = _best(lambda: U.propagate(src, draws=draws, seed=2), repeat=2)
+    t_kernel = _best(lambda: reconstruct_batch(cols), repeat=3)
+    return {"draws": draws, "propagate_s": t_mc, "reconstruct_batch_s": t_kernel,
+            "ratio": t_mc / t_kernel}
+
+
+def jacobian_vs_value(rows: int = 200_000) -> dict:
+    from impactsym import _kernels, batch
+
+    rng = np.random.default_rng(1)
+    out = {}
+    reconstruct = {**SCENE, **{k: SCENE[k] + sd * rng.standard_normal(rows)
+                               for k, sd in UNCERTAIN.items()}}
+    rigid = dict(m1=1500.0, m2=1200.0, I1=2500.0, I2=2000.0, v1x=20 + rng.standard_normal(rows),
+                 v1y=0.0, w1=0.1, v2x=0.0, v2y=15 + rng.standard_normal(rows), w2=0.0, r1x=2.0,
+                 r1y=0.3, r2x=-0.5, r2y=-2.0, gamma=0.3, e=0.2, mu=-0.4, e_m=0.8)
+    for name, value_ks, cols in (("reconstruct", _kernels.RECONSTRUCT, reconstruct),
+                                 ("rigid", _kernels.kernel_for("rigid", False), rigid)):
+        jac = _kernels.JACOBIAN[name]
+        start = time.perf_counter()
+        batch.run_columns(jac, cols, jac.outputs)  # compiles the driver
+        compile_s = time.perf_counter() - start
+        batch.run_columns(value_ks, cols, value_ks.outputs)
+        t_jac = _best(lambda: batch.run_columns(jac, cols, jac.outputs))
+        t_val = _best(lambda: batch.run_columns(value_ks, cols, value_ks.outputs))
+        out[name] = {"rows": rows, "jacobian_s": t_jac, "value_s": t_val, "ratio": t_jac / t_val,
+                     "jacobian_outputs": len(jac.outputs), "first_call_s": compile_s}
+    return out
+
+
+CHILD = """
+import resource, sys, time
+from benchmarks.uncertainty import source
+from impactsym import uncertainty as U
+start = time.perf_counter()
+r = U.propagate(source(), draws={draws}, seed=3)
+print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, time.perf_counter() - start,
+      r.accepted)
+"""
+
+
+def stream_memory(draws: int) -> dict:
+    """Peak RSS [MB] of a child streaming `draws` draws, and of one with one chunk."""
+    out = {}
+    for label, n in (("one_chunk", 1 << 18), ("stream", draws)):
+        text = subprocess.run([sys.executable, "-c", CHILD.format(draws=n)], check=True,
+                              capture_output=True, text=True).stdout.split()
+        out[label] = {"draws": n, "peak_rss_mb": float(text[0]), "seconds": float(text[1]),
+                      "accepted": int(text[2])}
+    out["ratio"] = out["stream"]["peak_rss_mb"] / out["one_chunk"]["peak_rss_mb"]
+    return out
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("--draws", type=int, default=1_000_000, help="end-to-end draws")
+    parser.add_argument("--stream", type=int, default=100_000_000, help="draws of the memory test")
+    parser.add_argument("--rows", type=int, default=200_000, help="rows of the kernel comparison")
+
+
+def main(args) -> int:
+    print("end to end:", end_to_end(args.draws), flush=True)
+    print("jacobian vs value:", jacobian_vs_value(args.rows), flush=True)
+    print("streaming memory:", stream_memory(args.stream), flush=True)
+    return 0
