@@ -35,7 +35,7 @@ UNCERTAIN = {"V1x": 0.3, "V1y": 0.3, "V2x": 0.3, "V2y": 0.3, "m1": 30.0, "m2": 3
 
 def source():
     """A column-level reconstruction with eight normal inputs (named by column)."""
-    from impactsym import uncertainty as U
+    from impactsym import propagation as U
 
     inputs = tuple(U.Input(k, "normal", (SCENE[k], sd)) for k, sd in UNCERTAIN.items())
 
@@ -57,7 +57,7 @@ def _best(func, repeat: int = 3) -> float:
 
 def end_to_end(draws: int) -> dict:
     from impactsym import reconstruct_batch
-    from impactsym import uncertainty as U
+    from impactsym import propagation as U
 
     src = source()
     U.propagate(src, draws=1 << 16, seed=1)  # compile and warm up
@@ -97,7 +97,7 @@ def jacobian_vs_value(rows: int = 200_000) -> dict:
 CHILD = """
 import resource, sys, time
 from benchmarks.uncertainty import source
-from impactsym import uncertainty as U
+from impactsym import propagation as U
 start = time.perf_counter()
 r = U.propagate(source(), draws={draws}, seed=3)
 print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, time.perf_counter() - start,

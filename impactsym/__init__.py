@@ -13,6 +13,7 @@ on vehicle 1; lower case initial, upper case final).
     table = impactsym.solve_batch(columns, model="rigid")
     grid = impactsym.sweep("examples/two_car_us.json", e=[0.1, 0.2], mu=[0.0, 0.3])
     draws = impactsym.sample("examples/two_car_us.json", {"e": ("uniform", 0, 0.3)}, 1000, seed=1)
+    u = impactsym.uncertainty("case.json", command="reconstruct", draws=100_000, seed=1)
 """
 
 from .batch import solve_batch
@@ -28,6 +29,7 @@ from .result import Result
 from .scene import MODELS, Impact, Scene, SceneError, Vehicle, load_scene
 from .single import solve
 from .sweep import percentiles, sample, sweep
+from .propagation import uncertainty
 
 __version__ = "0.1.0"
 
@@ -35,5 +37,5 @@ __all__ = [
     "FLAG_MESSAGES", "MODELS", "STATUS_MESSAGES", "Impact", "Result", "Scene", "SceneError",
     "Vehicle", "compare", "crash3", "delta_v_from_energy", "describe_flags", "describe_status",
     "explore", "invert", "invert_batch", "load_scene", "percentiles", "plot", "reconstruct",
-    "reconstruct_batch", "sample", "solve", "solve_batch", "sweep",
+    "reconstruct_batch", "sample", "solve", "solve_batch", "sweep", "uncertainty",
 ]

@@ -14,7 +14,7 @@ import argparse
 import json
 
 from .scene import SceneError
-from .uncertainty import uncertainty
+from .propagation import uncertainty
 
 DEFAULT_DRAWS = 10_000
 

@@ -19,7 +19,7 @@ import pytest
 from mpmath import mp
 
 from impactsym import _kernels, solve_batch
-from impactsym import uncertainty as U
+from impactsym import propagation as U
 
 from . import reference
 
