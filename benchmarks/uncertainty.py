@@ -26,9 +26,9 @@ import numpy as np
 
 DESCRIPTION = "uncertainty: 1e6-draw reconstruction, Jacobian vs value kernels, streaming memory"
 
-SCENE = dict(m1=1500.0, m2=1200.0, I1=2500.0, I2=2000.0, V1x=13.97, V1y=-1.71, W1=-0.50,
-             V2x=4.70, V2y=9.86, W2=0.45, theta1=0.0, theta2=math.pi / 2, w1=0.0, w2=0.0,
-             r1x=2.0, r1y=0.3, r2x=-0.5, r2y=-2.0, gamma=0.3)
+SCENE = {"m1": 1500.0, "m2": 1200.0, "I1": 2500.0, "I2": 2000.0, "V1x": 13.97, "V1y": -1.71,
+         "W1": -0.50, "V2x": 4.70, "V2y": 9.86, "W2": 0.45, "theta1": 0.0, "theta2": math.pi / 2,
+         "w1": 0.0, "w2": 0.0, "r1x": 2.0, "r1y": 0.3, "r2x": -0.5, "r2y": -2.0, "gamma": 0.3}
 UNCERTAIN = {"V1x": 0.3, "V1y": 0.3, "V2x": 0.3, "V2y": 0.3, "m1": 30.0, "m2": 30.0,
              "theta1": 0.02, "theta2": 0.02}
 
@@ -56,8 +56,8 @@ def _best(func, repeat: int = 3) -> float:
 
 
 def end_to_end(draws: int) -> dict:
-    from impactsym import reconstruct_batch
     from impactsym import propagation as U
+    from impactsym import reconstruct_batch
 
     src = source()
     U.propagate(src, draws=1 << 16, seed=1)  # compile and warm up
@@ -77,9 +77,10 @@ def jacobian_vs_value(rows: int = 200_000) -> dict:
     out = {}
     reconstruct = {**SCENE, **{k: SCENE[k] + sd * rng.standard_normal(rows)
                                for k, sd in UNCERTAIN.items()}}
-    rigid = dict(m1=1500.0, m2=1200.0, I1=2500.0, I2=2000.0, v1x=20 + rng.standard_normal(rows),
-                 v1y=0.0, w1=0.1, v2x=0.0, v2y=15 + rng.standard_normal(rows), w2=0.0, r1x=2.0,
-                 r1y=0.3, r2x=-0.5, r2y=-2.0, gamma=0.3, e=0.2, mu=-0.4, e_m=0.8)
+    rigid = {"m1": 1500.0, "m2": 1200.0, "I1": 2500.0, "I2": 2000.0,
+             "v1x": 20 + rng.standard_normal(rows), "v1y": 0.0, "w1": 0.1, "v2x": 0.0,
+             "v2y": 15 + rng.standard_normal(rows), "w2": 0.0, "r1x": 2.0, "r1y": 0.3,
+             "r2x": -0.5, "r2y": -2.0, "gamma": 0.3, "e": 0.2, "mu": -0.4, "e_m": 0.8}
     for name, value_ks, cols in (("reconstruct", _kernels.RECONSTRUCT, reconstruct),
                                  ("rigid", _kernels.kernel_for("rigid", False), rigid)):
         jac = _kernels.JACOBIAN[name]
@@ -87,8 +88,8 @@ def jacobian_vs_value(rows: int = 200_000) -> dict:
         batch.run_columns(jac, cols, jac.outputs)  # compiles the driver
         compile_s = time.perf_counter() - start
         batch.run_columns(value_ks, cols, value_ks.outputs)
-        t_jac = _best(lambda: batch.run_columns(jac, cols, jac.outputs))
-        t_val = _best(lambda: batch.run_columns(value_ks, cols, value_ks.outputs))
+        t_jac = _best(lambda jac=jac, cols=cols: batch.run_columns(jac, cols, jac.outputs))
+        t_val = _best(lambda ks=value_ks, cols=cols: batch.run_columns(ks, cols, ks.outputs))
         out[name] = {"rows": rows, "jacobian_s": t_jac, "value_s": t_val, "ratio": t_jac / t_val,
                      "jacobian_outputs": len(jac.outputs), "first_call_s": compile_s}
     return out

@@ -202,7 +202,7 @@ def proofs():
     """(claim, passed): every Jacobian kernel's derivative outputs equal
     SymPy's derivatives of its value kernel's outputs at random points."""
     rng = random.Random(20261123)
-    return [(f"{knl.name}: every d_output__d_input equals sympy.diff of the expanded "
-             f"{base.name} output at 2 random rational points ({DIGITS} digits)",
+    return [((f"{knl.name}: every d_output__d_input equals sympy.diff of the expanded "
+              f"{base.name} output at 2 random rational points ({DIGITS} digits)"),
              _agrees(knl, base, rng, points=2))
             for knl, base in zip(KERNELS, BASES)]

@@ -16,20 +16,20 @@ on vehicle 1; lower case initial, upper case final).
     u = impactsym.uncertainty("case.json", command="reconstruct", draws=100_000, seed=1)
 """
 
+from . import plot
 from .batch import solve_batch
+from .codes import FLAG_MESSAGES, STATUS_MESSAGES, describe_flags, describe_status
 from .compare import compare
 from .crash3 import crash3
-from .codes import FLAG_MESSAGES, STATUS_MESSAGES, describe_flags, describe_status
-from . import plot
 from .energy import delta_v_from_energy
 from .explore import explore
 from .inverse import invert, invert_batch
+from .propagation import uncertainty
 from .reconstruct import reconstruct, reconstruct_batch
 from .result import Result
 from .scene import MODELS, Impact, Scene, SceneError, Vehicle, load_scene
 from .single import solve
 from .sweep import percentiles, sample, sweep
-from .propagation import uncertainty
 
 __version__ = "0.1.0"
 

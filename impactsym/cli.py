@@ -12,26 +12,35 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from collections.abc import Callable
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
 from . import uncertainty_cli
 from .compare import compare
 from .crash3 import crash3
-from .scene import SceneError
 from .inverse import invert
 from .plot import add_plot_argument, save_plot
 from .reconstruct import reconstruct
 from .result import UNIT_LABELS, json_number, table_cell
+from .scene import SceneError
 from .single import solve
-from .sweep import (CHUNK_SIZE, PERCENTILES, SUMMARY_COLUMNS, SWEEP_PERCENTILES, GridPlan,
-                    SamplePlan, percentiles, summarize, write_frame)
+from .sweep import (
+    CHUNK_SIZE,
+    PERCENTILES,
+    SUMMARY_COLUMNS,
+    SWEEP_PERCENTILES,
+    GridPlan,
+    SamplePlan,
+    percentiles,
+    summarize,
+    write_frame,
+)
 from .sweep import sweep as solve_sweep
 
-__all__ = ["main", "build_parser", "Command", "COMMANDS"]
+__all__ = ["COMMANDS", "Command", "build_parser", "main"]
 
 PROG = "impactsym"
 EXIT_BAD_INPUT = 2

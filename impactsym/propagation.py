@@ -43,15 +43,16 @@ fraction so replaced is reported.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import numpy as np
 
-from . import _kernels
-from .batch import solve_batch
 from generated import codes as _codes
 
+from . import _kernels
+from .batch import solve_batch
 from .inverse import invert_batch
 from .reconstruct import reconstruct_batch
 from .sweep import BLOCK, CHUNK_SIZE, SamplePlan
@@ -59,7 +60,7 @@ from .sweep import BLOCK, CHUNK_SIZE, SamplePlan
 STATUS_NAMES = {getattr(_codes, n): n[len("STATUS_"):] for n in dir(_codes) if n.startswith("STATUS_")}
 FLAG_NAMES = {n[len("FLAG_"):]: getattr(_codes, n) for n in dir(_codes) if n.startswith("FLAG_")}
 
-__all__ = ["Input", "Uncertainty", "propagate", "uncertainty", "COMMANDS", "KEEP"]
+__all__ = ["COMMANDS", "KEEP", "Input", "Uncertainty", "propagate", "uncertainty"]
 
 COMMANDS = ("solve", "invert", "reconstruct", "crash3")
 #: Accepted draws kept for the caller (`Uncertainty.draws`); statistics use every draw.
@@ -557,8 +558,8 @@ class Uncertainty:
             lines.append("rejected: " + ", ".join(f"{k} {v}" for k, v in self.rejected.items()))
         lines += [f"note: {n}" for n in self.notes]
         width = max(len(p) for p in self.outputs) + 2
-        lines += ["", f"{'output':<{width}}{'nominal':>12}{'mean':>12}{'90 % interval':>26}"
-                  "  largest budget shares"]
+        lines += ["", (f"{'output':<{width}}{'nominal':>12}{'mean':>12}{'90 % interval':>26}"
+                       "  largest budget shares")]
         for path, o in self.outputs.items():
             top = sorted(self.budget.get(path, {}).items(), key=lambda kv: -abs(kv[1]))[:3]
             interval = f"[{_cell(o['p5'])}, {_cell(o['p95'])}]"

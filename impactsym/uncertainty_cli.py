@@ -13,8 +13,8 @@ from __future__ import annotations
 import argparse
 import json
 
-from .scene import SceneError
 from .propagation import uncertainty
+from .scene import SceneError
 
 DEFAULT_DRAWS = 10_000
 

@@ -6,7 +6,6 @@ backend into a file; nothing is shown on screen.
 
 from __future__ import annotations
 
-
 import numpy as np
 
 #: Outputs drawn first when present (the answers a reconstructionist reports).

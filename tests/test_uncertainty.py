@@ -23,9 +23,9 @@ from impactsym import propagation as U
 
 from . import reference
 
-SCENE = dict(m1=1500.0, m2=1200.0, I1=2500.0, I2=2000.0, v1x=20.0, v1y=0.0, w1=0.1,
-             v2x=0.0, v2y=15.0, w2=0.0, r1x=2.0, r1y=0.3, r2x=-0.5, r2y=-2.0, gamma=0.3,
-             e=0.2, mu=-0.4, e_m=0.8)
+SCENE = {"m1": 1500.0, "m2": 1200.0, "I1": 2500.0, "I2": 2000.0, "v1x": 20.0, "v1y": 0.0,
+         "w1": 0.1, "v2x": 0.0, "v2y": 15.0, "w2": 0.0, "r1x": 2.0, "r1y": 0.3, "r2x": -0.5,
+         "r2y": -2.0, "gamma": 0.3, "e": 0.2, "mu": -0.4, "e_m": 0.8}
 
 
 def _close(got, want, names, outputs):
@@ -47,8 +47,8 @@ def _mp_gradient(func, point: dict, names, outputs):
                 # The reference rounds to 50 digits inside: a central step
                 # of 1e-15 relative (error ~1e-30) instead of mpmath's default.
                 step = mp.mpf("1e-15") * max(1, abs(point[x]))
-                grads[o][x] = mp.diff(lambda t: func({**point, x: t})[o], mp.mpf(point[x]),
-                                      h=step)
+                grads[o][x] = mp.diff(lambda t, x=x, o=o: func({**point, x: t})[o],
+                                      mp.mpf(point[x]), h=step)
     return grads
 
 
@@ -241,3 +241,21 @@ def test_sobol_first_order_indices_rank_the_dominant_input():
     s1 = result.sobol["vehicles[1].speed"]["S1"]
     assert max(s1, key=s1.get) == "V1y"
     assert s1["V1y"] > 0.9
+
+
+def test_jacobian_proof_catches_a_wrong_derivative():
+    """The proof of derive/jacobian.py fails when one derivative formula is off."""
+    import random
+    from dataclasses import replace
+
+    from derive import jacobian
+    from derive.kernel import Block
+
+    index = next(i for i, k in enumerate(jacobian.BASES) if k.name == "particle")
+    knl, base = jacobian.KERNELS[index], jacobian.BASES[index]
+    assert jacobian._agrees(knl, base, random.Random(1), points=1)
+    blocks = list(knl.blocks)
+    at = next(i for i, b in enumerate(blocks) if any(s.name == "d_TL__d_e" for s, _ in b.assigns))
+    blocks[at] = Block(tuple((s, x * 1.000001 if s.name == "d_TL__d_e" else x)
+                             for s, x in blocks[at].assigns), blocks[at].guard)
+    assert not jacobian._agrees(replace(knl, blocks=tuple(blocks)), base, random.Random(1), points=1)
