@@ -72,6 +72,7 @@ PERCENTILES = (5.0, 50.0, 95.0)
 REJECTING_FLAGS = ("ENERGY_CREATED", "TENSILE_IMPULSE", "MU_BEYOND_CRITICAL",
                    "E_OUT_OF_RANGE", "NEGATIVE_SPEED")
 COMPLEX_STEP = 1e-30
+DEGREES = 180.0 / math.pi
 
 
 # --------------------------------------------------------------------------- inputs
@@ -364,7 +365,7 @@ def _crash3_outputs(c: Mapping, v: Mapping) -> dict:
         out.update({f"{p}.crush_energy": v[f"E{i}"], f"{p}.crush_energy_uncorrected": v[f"E_crush{i}"],
                     f"{p}.effective_mass_factor": v[f"mass_factor{i}"], f"{p}.moment_arm": v[f"h{i}"],
                     f"{p}.delta_v[0]": v[f"dV{i}x"], f"{p}.delta_v[1]": v[f"dV{i}y"],
-                    f"{p}.delta_v_magnitude": v[f"dV{i}"]})
+                    f"{p}.delta_v_magnitude": v[f"dV{i}"], f"{p}.pdof": v[f"alpha{i}"] * DEGREES})
     out["energy_total"], out["impulse"] = v["E"], v["P"]
     return out
 
