@@ -7,8 +7,11 @@ machine is shared; absolute times are noisy, ratios less so):
    to end (draws, copula, kernels, rejection, statistics, linear budget),
    after a first call has compiled everything; baseline: ``reconstruct_batch``
    alone on N rows of fixed columns.
-2. A Jacobian kernel's parallel batch driver per scene against its value
-   kernel's (reconstruct and rigid), same rows.
+2. A Jacobian kernel per scene against its value kernel: the plain-Python
+   per-scene functions (what the linear method runs) for reconstruct, rigid
+   and particle, and the numba parallel drivers for the particle kernel (the
+   rigid and reconstruct Jacobian drivers, 250-300 outputs of straight-line
+   code, take numba more than five minutes to compile: not measured).
 3. Peak resident memory of a child process streaming ``--stream`` draws,
    against a child streaming 2^18 draws (one chunk).
 
@@ -71,27 +74,42 @@ def end_to_end(draws: int) -> dict:
 
 
 def jacobian_vs_value(rows: int = 200_000) -> dict:
+    """Per scene: the plain-Python per-scene function (what the linear method
+    runs, once per scene) of each Jacobian kernel against its value kernel's;
+    and for the particle kernel, whose Jacobian driver compiles in reasonable
+    time, the numba parallel drivers over `rows` rows."""
     from impactsym import _kernels, batch
 
-    rng = np.random.default_rng(1)
     out = {}
-    reconstruct = {**SCENE, **{k: SCENE[k] + sd * rng.standard_normal(rows)
-                               for k, sd in UNCERTAIN.items()}}
-    rigid = {"m1": 1500.0, "m2": 1200.0, "I1": 2500.0, "I2": 2000.0,
-             "v1x": 20 + rng.standard_normal(rows), "v1y": 0.0, "w1": 0.1, "v2x": 0.0,
-             "v2y": 15 + rng.standard_normal(rows), "w2": 0.0, "r1x": 2.0, "r1y": 0.3,
-             "r2x": -0.5, "r2y": -2.0, "gamma": 0.3, "e": 0.2, "mu": -0.4, "e_m": 0.8}
-    for name, value_ks, cols in (("reconstruct", _kernels.RECONSTRUCT, reconstruct),
-                                 ("rigid", _kernels.kernel_for("rigid", False), rigid)):
+    point = {"m1": 1500.0, "m2": 1200.0, "I1": 2500.0, "I2": 2000.0, "v1x": 20.0, "v1y": 0.0,
+             "w1": 0.1, "v2x": 0.0, "v2y": 15.0, "w2": 0.0, "r1x": 2.0, "r1y": 0.3, "r2x": -0.5,
+             "r2y": -2.0, "gamma": 0.3, "e": 0.2, "mu": -0.4, "e_m": 0.8}
+    for name, value_ks, values in (("reconstruct", _kernels.RECONSTRUCT, SCENE),
+                                   ("rigid", _kernels.KERNELS[("rigid", False, False, "energy")],
+                                    point),
+                                   ("particle", _kernels.KERNELS[("particle", False, False, "energy")],
+                                    point)):
         jac = _kernels.JACOBIAN[name]
-        start = time.perf_counter()
-        batch.run_columns(jac, cols, jac.outputs)  # compiles the driver
-        compile_s = time.perf_counter() - start
-        batch.run_columns(value_ks, cols, value_ks.outputs)
-        t_jac = _best(lambda jac=jac, cols=cols: batch.run_columns(jac, cols, jac.outputs))
-        t_val = _best(lambda ks=value_ks, cols=cols: batch.run_columns(ks, cols, ks.outputs))
-        out[name] = {"rows": rows, "jacobian_s": t_jac, "value_s": t_val, "ratio": t_jac / t_val,
-                     "jacobian_outputs": len(jac.outputs), "first_call_s": compile_s}
+        reps = 200
+        t_jac = _best(lambda jac=jac, v=values: [_kernels.run_one(jac, v, jac.outputs)
+                                                 for _ in range(reps)]) / reps
+        t_val = _best(lambda ks=value_ks, v=values: [_kernels.run_one(ks, v, ks.outputs)
+                                                     for _ in range(reps)]) / reps
+        out[f"{name} per scene (plain Python)"] = {
+            "jacobian_us": 1e6 * t_jac, "value_us": 1e6 * t_val, "ratio": t_jac / t_val,
+            "jacobian_outputs": len(jac.outputs)}
+    rng = np.random.default_rng(1)
+    cols = {k: v for k, v in point.items() if k in _kernels.JACOBIAN["particle"].inputs}
+    cols["v1x"] = 20 + rng.standard_normal(rows)
+    jac, val = _kernels.JACOBIAN["particle"], _kernels.KERNELS[("particle", False, False, "energy")]
+    start = time.perf_counter()
+    batch.run_columns(jac, cols, jac.outputs)
+    compile_s = time.perf_counter() - start
+    batch.run_columns(val, cols, val.outputs)
+    t_jac = _best(lambda: batch.run_columns(jac, cols, jac.outputs))
+    t_val = _best(lambda: batch.run_columns(val, cols, val.outputs))
+    out["particle batch (numba, parallel)"] = {"rows": rows, "jacobian_s": t_jac, "value_s": t_val,
+                                               "ratio": t_jac / t_val, "first_call_s": compile_s}
     return out
 
 
