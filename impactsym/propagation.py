@@ -201,7 +201,8 @@ def _inverse_outputs(c: Mapping, o: Mapping, yaw: bool) -> dict:
         dx, dy = c[f"V{i}x"] - o[f"v{i}x"], c[f"V{i}y"] - o[f"v{i}y"]
         out[f"{v}.delta_v[0]"], out[f"{v}.delta_v[1]"] = dx, dy
         out[f"{v}.delta_v_magnitude"] = _hypot(dx, dy)
-    return {**out, **_impulse_energy(o, yaw), "critical_impulse_ratio": o["mu_c"]}
+    return {**out, **_impulse_energy(o, yaw), "impulse_ratio": c["mu"],
+            "critical_impulse_ratio": o["mu_c"]}
 
 
 def _reconstruct_outputs(c: Mapping, o: Mapping, yaw: bool = True) -> dict:
@@ -366,6 +367,8 @@ def _crash3_outputs(c: Mapping, v: Mapping) -> dict:
                     f"{p}.effective_mass_factor": v[f"mass_factor{i}"], f"{p}.moment_arm": v[f"h{i}"],
                     f"{p}.delta_v[0]": v[f"dV{i}x"], f"{p}.delta_v[1]": v[f"dV{i}y"],
                     f"{p}.delta_v_magnitude": v[f"dV{i}"], f"{p}.pdof": v[f"alpha{i}"] * DEGREES})
+        if f"dV{i}_eff" in v:  # EDCRASH's effective-mass delta-V, where the kernel has it
+            out[f"{p}.delta_v_effective_mass"] = v[f"dV{i}_eff"]
     out["energy_total"], out["impulse"] = v["E"], v["P"]
     return out
 
@@ -826,10 +829,16 @@ def sobol_indices(source: Source, draws: int, seed, stats: dict) -> dict:
 # --------------------------------------------------------------------------- scenes
 
 def uncertainty(scene, command: str = "solve", draws: int = 10_000, seed: int | None = None,
-                sobol: bool = False, restitution: float = 0.0) -> Uncertainty:
+                sobol: bool = False, restitution: float = 0.0, energy: str | None = None,
+                correction: str | None = None) -> Uncertainty:
     """Uncertainty of ``command``'s answers for a scene whose leaves carry
     distributions (see the module docstring and conventions.md, Uncertainty).
-    ``restitution``: CRASH3's restitution (crash3 only)."""
+    ``restitution``, ``energy``, ``correction``: CRASH3's options (crash3
+    only; the uncertainty of CRASH3 supports its default energy treatment,
+    dissipated, and the 1 + tan²α correction)."""
+    if energy not in (None, "dissipated") or correction not in (None, "crash3"):
+        raise ValueError("--uncertainty of crash3 supports energy 'dissipated' and correction "
+                         f"'crash3' only, got energy {energy!r}, correction {correction!r}")
     return propagate(scene_source(scene, command, restitution), draws=draws, seed=seed,
                      sobol=sobol)
 
