@@ -5,5 +5,5 @@
   difference, a per-row linear solve, ``sympy.lambdify``) on a realistic and a
   stress set; writes ``benchmarks/results/accuracy.md`` and ``accuracy.png``.
 
-Run from the repository root (``tests.reference`` is the 50-digit reference).
+Run from the repository root (``impactsym.testing.reference`` is the 50-digit reference).
 """

@@ -15,6 +15,7 @@ SUBCOMMANDS = {
     "inverse": "benchmarks.inverse",
     "performance": "benchmarks.performance",
     "uncertainty": "benchmarks.uncertainty",
+    "trig": "benchmarks.trig",
 }
 
 

@@ -21,7 +21,7 @@ outputs ``V1x V1y W1 V2x V2y W2 Pn Pt M mu mu_c TL TLn TLt TLm``):
 Variants are rendered into a temporary directory as real ``.py`` files and imported
 (numba cannot cache code that was exec'd), so each run compiles them afresh.
 
-Error of an output = |got - reference| / its natural scale (``tests.reference``);
+Error of an output = |got - reference| / its natural scale (``impactsym.testing.reference``);
 error of a row = the largest over the 15 outputs; a row whose output is NaN or
 infinite where the reference is finite has infinite error ("fail"). Reported per
 set: the worst row and the 99th percentile (the smallest error that at least 99 %
@@ -36,6 +36,7 @@ scene, and its ratio to the default kernel.
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import math
 import os
@@ -43,9 +44,9 @@ import platform
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -169,10 +170,8 @@ def _solve_stack(A, b):
     except np.linalg.LinAlgError:
         x = np.full(b.shape[:2], np.nan)
         for i in range(A.shape[0]):
-            try:
+            with contextlib.suppress(np.linalg.LinAlgError):  # a singular row stays NaN
                 x[i] = np.linalg.solve(A[i], b[i])[:, 0]
-            except np.linalg.LinAlgError:
-                pass
         return x
 
 
@@ -318,7 +317,7 @@ def set_errors(outs: dict, scene_set, energy_floor: float = 1e-10) -> SetErrors:
     """Natural-scale errors of ``outs`` (arrays by output name) against the set's references."""
     from mpmath import mp
 
-    from tests import reference as R
+    from impactsym.testing import reference as R
 
     n = scene_set.n
     row = np.empty(n)
@@ -438,7 +437,7 @@ def markdown(methods, timing, errors, sets, args) -> str:
         "*p99* (99 % of rows are within it). A row whose output is NaN where the reference is "
         "finite fails (infinite error). *bits*: bits lost on the worst row, log2(worst / 2^-53).",
         "",
-        f"Sets: **realistic** = `tests.scenes.random_realistic({sets['realistic'].n}, "
+        f"Sets: **realistic** = `impactsym.testing.scenes.random_realistic({sets['realistic'].n}, "
         f"seed={S.REALISTIC_SEED})`; **stress** = `benchmarks.sets.stress_set()`, "
         f"{sets['stress'].n} constructed rows (families below).",
         "",
@@ -569,8 +568,7 @@ def chart(methods, timing, errors, path: Path, n: int) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.ticker import (FixedLocator, FormatStrFormatter, NullFormatter,
-                                   NullLocator)
+    from matplotlib.ticker import FixedLocator, FormatStrFormatter, NullFormatter, NullLocator
 
     colors = plt.get_cmap("tab10").colors
     fig, axes = plt.subplots(1, 2, figsize=(13, 5.8), sharey=True, constrained_layout=True)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 import impactsym
-from tests import scenes
+from impactsym.testing import scenes
 
 DESCRIPTION = "round-trip error of the inverse solution as e -> 0"
 RESTITUTIONS = (0.5, 0.1, 0.05, 0.01, 1e-3, 1e-4, 1e-5, 1e-6)

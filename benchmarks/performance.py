@@ -41,6 +41,7 @@ takes an early exit; the share of status-0 rows is reported.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import os
@@ -53,9 +54,9 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -358,7 +359,7 @@ def time_cases(cases: list[Case], repeat: int, quiet: Quiet, log) -> dict:
         case.times = {what: [] for what in runs[case.key]}
         case.faults = {what: [] for what in runs[case.key]}
     for r in range(repeat):
-        samples = quiet.run("1", lambda: _time_round(cases, runs, r))
+        samples = quiet.run("1", lambda r=r: _time_round(cases, runs, r))
         by_key = {c.key: c for c in cases}
         for (key, what), (ns, faults) in samples.items():
             by_key[key].times[what].append(ns)
@@ -647,7 +648,7 @@ def run_sweep(points: int) -> dict:
         code = os.waitstatus_to_exitcode(status)
         size = out.stat().st_size if out.exists() else 0
     shown = ["impactsym"] + cmd[1:]
-    shown[shown.index("-o") + 1] = "/tmp/…/sweep.parquet"
+    shown[shown.index("-o") + 1] = "TMPDIR/sweep.parquet"
     return {"command": " ".join(shown),
             "rows": k * k, "wall_s": wall, "rows_per_s": k * k / wall, "exit_code": code,
             "peak_rss_gb": usage.ru_maxrss / 2**20, "file_gb": size / 1e9,
@@ -782,11 +783,10 @@ def _machine() -> str:
     import numba
 
     cpu = "?"
-    try:
-        cpu = next(line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo")
+    with contextlib.suppress(OSError, StopIteration):
+        cpu = next(line.split(":", 1)[1].strip()
+                   for line in Path("/proc/cpuinfo").read_text().splitlines()
                    if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
     return (f"{platform.machine()} {cpu}, {os.cpu_count()} CPUs, numba {numba.__version__} "
             f"({numba.get_num_threads()} threads, threading layer "
             f"{numba.threading_layer()}, SVML {'on' if numba.config.USING_SVML else 'off'}), "

@@ -1,6 +1,6 @@
 """Scene sets for the accuracy benchmark, and their 50-digit references.
 
-* ``realistic_set()``: random two-car scenes (``tests.scenes.random_realistic``,
+* ``realistic_set()``: random two-car scenes (``impactsym.testing.scenes.random_realistic``,
   rigid model, given impulse ratio), the everyday workload.
 * ``stress_set()``: a few hundred exactly constructed hard rows, each with a family
   label: near-elastic (``e = 1 - 2**-k``), near-grazing, extreme mass ratios and
@@ -8,7 +8,7 @@
   values, extreme speed scales, central impacts.
 
 Columns follow conventions.md (float64 arrays, SI units, ``gamma`` in radians).
-References come from ``tests.reference`` (the six equations solved as one linear
+References come from ``impactsym.testing.reference`` (the six equations solved as one linear
 system at 50 digits on the exact float64 inputs), so a measured error is the
 method's alone. A reference costs a few milliseconds a row, so nothing is cached.
 """
@@ -20,8 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 from mpmath import mp
 
-from tests import reference as R
-from tests import scenes
+from impactsym.testing import reference as R
+from impactsym.testing import scenes
 
 INPUTS = tuple(R.RIGID_INPUTS)
 REALISTIC_SEED = 20260611
@@ -67,7 +67,7 @@ def with_references(name: str, columns: dict, family=None) -> SceneSet:
 
 
 def realistic_set(n: int = REALISTIC_ROWS, seed: int = REALISTIC_SEED) -> dict:
-    """``n`` random realistic rigid scenes (``tests.scenes.random_realistic``)."""
+    """``n`` random realistic rigid scenes (``impactsym.testing.scenes.random_realistic``)."""
     return scenes.random_realistic(n, seed=seed)
 
 

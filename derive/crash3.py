@@ -8,9 +8,15 @@ work of that line from -A/B to C, A·C + B·C²/2 + G = (A + B·C)²/(2B) ≥ 0.
 profile of N = 2, 4 or 6 equally spaced depths C1..CN over the damage width L,
 linear between them, is integrated symbolically segment by segment. The
 principal direction of force (PDOF) at an angle α to the normal of the damaged
-face scales the energy by 1 + tan²α (the crush measured along the normal
-underestimates the work of an oblique force); CRASH3 limits that to |α| ≤ 45°,
-enforced here with a status.
+face scales the energy by CRASH3's energy correction factor 1 + tan²α (the
+crush measured along the normal underestimates the work of an oblique force),
+or by Woolley's 1/cos α (R. L. Woolley, SAE 850437 / 851659: the force along the
+PDOF does work over the crush projected on it). EDCRASH caps the CRASH3 factor
+at 2, i.e. α at 45° (Day & Hargens, SAE 870045, citing the EDCRASH manual; the
+McHenry Software notes on the "Energy Correction Factor" give the same
+maximum of 2.0 for CRASH3): both factors are computed at min(|α|, 45°), and a
+capped row raises the PDOF_CAPPED flag. |α| ≥ 90° (a force pulling the face
+out) is the status PDOF_BEYOND_LIMIT.
 
 Delta-V. CRASH3 treats the impact as one-dimensional along the PDOF with a
 common velocity at the impact centre (e = 0; restitution e optional): each
@@ -21,6 +27,20 @@ masses with restitution e fixes the impulse |P| = √(2 E m̄ (1 + e)/(1 - e)),
 m̄ = 1/(1/(γ1 m1) + 1/(γ2 m2)), and ΔV_i = |P|/m_i, directed along the PDOF:
 the force on vehicle 1 is -|P|·(cos(Γ + α1), sin(Γ + α1)) (α1 measured from its
 inward normal -n) and on vehicle 2 +|P|·(cos(Γ + α2), sin(Γ + α2)).
+
+Restitution and the crush energy (Rose, Fenton & Beauchamp, SAE 2006-01-0908).
+"dissipated" (kernel crash3_delta_v): E is the energy lost over the whole
+impact, E = m̄ v_c² (1 - e²)/2, so |P| = m̄ v_c (1 + e) = √(2 E m̄ (1 + e)/(1 - e)).
+"absorbed" (kernel crash3_delta_v_absorbed): E is the energy absorbed up to
+maximum crush (the common-velocity instant), E = m̄ v_c²/2; the approach impulse
+is √(2 E m̄) and the total (1 + e) times it. For the same E the two differ by
+the factor √(1 - e²) (proved below); at e = 0 they coincide.
+
+Which delta-V. ΔV_i = |P|/m_i is the change of the centre-of-gravity velocity
+(what an accelerometer at the CG measures, and what Brach, Neades and Rose
+report). EDCRASH (Day & Hargens) prints √(2E/(M1(1 + M1/M2))) with M = γ m, the
+change of velocity of the effective mass, |P|/(γ_i m_i) = ke_i |P|: the kernels
+output it as dV1_eff, dV2_eff, and ΔV_cg = γ ΔV_eff (proved below).
 
 The seed's criticism: CRASH uses μ = μ_max (a common velocity) for |ΔV| but the
 user's PDOF for the direction. The impulse-momentum model's own PDOF is
@@ -43,7 +63,8 @@ from .kernel import Block, Guard, Kernel, finite_inputs, positive_or_fixed, real
 A, B, width, alpha, G, E_crush, E = real("A B width alpha G E_crush E")
 DEPTHS = real("C1 C2 C3 C4 C5 C6")
 PROFILE_SIZES = (2, 4, 6)
-PDOF_LIMIT = sp.pi / 4  # CRASH3's limit on |α| for the 1 + tan²α correction
+PDOF_CAP = sp.pi / 4  # EDCRASH's cap: the factor 1 + tan²α at most 2, α at most 45°
+PDOF_LIMIT = sp.pi / 2  # beyond it the force would pull the damaged face out
 
 # Per-segment integration symbols: crush Ca..Cb over a segment of width d.
 c, w, d, Ca, Cb = real("c w d Ca Cb")
@@ -69,21 +90,29 @@ def profile_energy(n: int):
                for i in range(n - 1))
 
 
+alpha_c, E_woolley = real("alpha_c E_woolley")
+
+
 def energy_kernel(n: int) -> Kernel:
-    """CRASH3 crush energy of one vehicle from an n-point profile (n = 2, 4, 6)."""
+    """CRASH3 crush energy of one vehicle from an n-point profile (n = 2, 4, 6),
+    with CRASH3's (E) and Woolley's (E_woolley) oblique corrections at the
+    capped angle alpha_c = min(|α|, 45°)."""
     depths = DEPTHS[:n]
     valid = (sp.GreaterThan(A, 0), sp.StrictGreaterThan(B, 0), sp.StrictGreaterThan(width, 0)) \
         + tuple(sp.GreaterThan(ci, 0) for ci in depths)
     return Kernel(
         name=f"crash3_energy_{n}",
-        doc=f"CRASH3 crush energy of a {n}-point profile, F/w = A + B*C; E = E_crush*(1 + tan^2 alpha).",
+        doc=f"CRASH3 crush energy of a {n}-point profile, F/w = A + B*C; E = E_crush*(1 + tan^2 "
+            "alpha_c), E_woolley = E_crush/cos(alpha_c), alpha_c = min(|alpha|, 45 deg).",
         inputs=(A, B, width, *depths, alpha),
         checks=(finite_inputs((A, B, width, *depths, alpha)), Guard(valid, "BAD_CRUSH"),
-                Guard((sp.LessThan(sp.Abs(alpha), PDOF_LIMIT),), "PDOF_BEYOND_LIMIT")),
-        blocks=(Block(((G, A**2 / (2 * B)),)),
+                Guard((sp.StrictLessThan(sp.Abs(alpha), PDOF_LIMIT),), "PDOF_BEYOND_LIMIT")),
+        blocks=(Block(((G, A**2 / (2 * B)), (alpha_c, sp.Min(sp.Abs(alpha), PDOF_CAP)))),
                 Block(((E_crush, profile_energy(n)),)),
-                Block(((E, E_crush * (1 + sp.tan(alpha)**2)),))),
-        outputs=(E_crush, E),
+                Block(((E, E_crush * (1 + sp.tan(alpha_c)**2)),
+                       (E_woolley, E_crush / sp.cos(alpha_c))))),
+        outputs=(E_crush, E, E_woolley),
+        flags=(("PDOF_CAPPED", (sp.StrictGreaterThan(sp.Abs(alpha), PDOF_CAP),)),),
     )
 
 
@@ -94,19 +123,34 @@ rx, ry, theta, mass, inertia, rg = real("rx ry theta mass inertia rg")
 ke1, ke2, ome, P, dV1, dV2 = real("ke1 ke2 one_minus_e P dV1 dV2")
 dV1x, dV1y, dV2x, dV2y, mass_factor1, mass_factor2, h = real(
     "dV1x dV1y dV2x dV2y mass_factor1 mass_factor2 h")
+dV1_eff, dV2_eff = real("dV1_eff dV2_eff")
+ENERGY_MODES = ("dissipated", "absorbed")
 pdof = sp.Symbol("pdof", real=True)
 
 
-def delta_v_kernel() -> Kernel:
-    """|P|, |ΔV_i|, the effective-mass factors and the ΔV vectors along the PDOFs."""
+def delta_v_kernel(energy: str = "dissipated") -> Kernel:
+    """|P|, |ΔV_i| (centre of gravity), the effective-mass factors, the
+    effective-mass delta-V and the ΔV vectors along the PDOFs. `energy` says
+    what the crush energy E is: "dissipated" over the whole impact or
+    "absorbed" up to maximum crush (module docstring)."""
+    if energy == "dissipated":
+        name, e_range = "crash3_delta_v", sp.StrictLessThan(e, 1)
+        impulse = sp.sqrt(2 * E * (1 + e) / (ome * (ke1 + ke2)))
+        doc = ("CRASH3 delta-V from the total crush energy E dissipated over the impact: 1-D "
+               "impact of effective masses gamma_i*m_i along the PDOF, restitution e "
+               "(0 = common velocity).")
+    else:
+        name, e_range = "crash3_delta_v_absorbed", sp.LessThan(e, 1)
+        impulse = (1 + e) * sp.sqrt(2 * E / (ke1 + ke2))
+        doc = ("CRASH3 delta-V from the crush energy E absorbed up to maximum crush: approach "
+               "impulse sqrt(2 E mbar), total (1 + e) times it (Rose et al., SAE 2006-01-0908).")
     return Kernel(
-        name="crash3_delta_v",
-        doc="CRASH3 delta-V from the total crush energy E: 1-D impact of effective masses "
-            "gamma_i*m_i along the PDOF, restitution e (0 = common velocity).",
+        name=name,
+        doc=doc,
         inputs=(m1, m2, rg1, rg2, h1, h2, E, e, gamma, alpha1, alpha2),
         checks=(finite_inputs((h1, h2, E, e, gamma, alpha1, alpha2), (m1, m2, rg1, rg2)),
                 positive_or_fixed((m1, m2, rg1, rg2)),
-                Guard((sp.GreaterThan(E, 0), sp.GreaterThan(e, 0), sp.StrictLessThan(e, 1)),
+                Guard((sp.GreaterThan(E, 0), sp.GreaterThan(e, 0), e_range),
                       "ENERGY_INCONSISTENT")),
         blocks=(
             Block(f.inverse_masses((m1, m2), (k1, k2))
@@ -115,12 +159,13 @@ def delta_v_kernel() -> Kernel:
             # 1/(γ m) = (1/m)(1 + h²/k²): exactly 0 for a fixed body.
             Block(((ke1, k1 * (1 + (h1 / rg1)**2)), (ke2, k2 * (1 + (h2 / rg2)**2))),
                   Guard((sp.StrictGreaterThan(ke1 + ke2, 0),), "SINGULAR")),
-            Block(((P, sp.sqrt(2 * E * (1 + e) / (ome * (ke1 + ke2)))),)),
-            Block(((dV1, k1 * P), (dV2, k2 * P))),
+            Block(((P, impulse),)),
+            Block(((dV1, k1 * P), (dV2, k2 * P), (dV1_eff, ke1 * P), (dV2_eff, ke2 * P))),
             Block(((dV1x, -dV1 * sp.cos(gamma + alpha1)), (dV1y, -dV1 * sp.sin(gamma + alpha1)),
                    (dV2x, dV2 * sp.cos(gamma + alpha2)), (dV2y, dV2 * sp.sin(gamma + alpha2)))),
         ),
-        outputs=(P, dV1, dV2, mass_factor1, mass_factor2, dV1x, dV1y, dV2x, dV2y),
+        outputs=(P, dV1, dV2, mass_factor1, mass_factor2, dV1x, dV1y, dV2x, dV2y,
+                 dV1_eff, dV2_eff),
     )
 
 
@@ -164,7 +209,8 @@ def implied_pdof_kernel() -> Kernel:
 
 
 KERNELS = tuple(energy_kernel(n) for n in PROFILE_SIZES) + (
-    delta_v_kernel(), moment_arm_kernel(), radius_of_gyration_kernel(), implied_pdof_kernel())
+    delta_v_kernel(), moment_arm_kernel(), radius_of_gyration_kernel(), implied_pdof_kernel(),
+    delta_v_kernel("absorbed"))
 
 
 # ---------------------------------------------------------------- proofs
@@ -201,10 +247,33 @@ def _energy_claims():
                 all(sp.expand(energies[n].xreplace({ci: uniform for ci in DEPTHS})
                               - width * (A * uniform + B * uniform**2 / 2 + G)) == 0
                     for n in PROFILE_SIZES)))
-    out.append(("crash3: the PDOF correction is E = E_crush / cos^2(alpha)",
-                all(sp.simplify(knl.expanded(E, frozenset({E_crush}))
-                                - E_crush / sp.cos(alpha)**2) == 0 for knl in KERNELS[:3])))
+    out += _correction_claims()
     return out
+
+
+def _correction_claims():
+    """The oblique corrections: below the cap E = E_crush/cos²α (CRASH3) and
+    E_woolley = E_crush/cos α; at the cap 2 E_crush and √2 E_crush; the capped
+    angle is |α| below 45° and 45° above (checked at sample angles)."""
+    cap = {sp.Min(sp.Abs(alpha), PDOF_CAP): PDOF_CAP}
+    below = {sp.Min(sp.Abs(alpha), PDOF_CAP): alpha}  # tan², cos are even: |α| → α
+    ok_below = ok_cap = True
+    for knl in KERNELS[:3]:
+        crash, woolley = (knl.expanded(x, frozenset({E_crush})) for x in (E, E_woolley))
+        ok_below &= sp.simplify(crash.xreplace(below) - E_crush / sp.cos(alpha)**2) == 0 \
+            and sp.simplify(woolley.xreplace(below) - E_crush / sp.cos(alpha)) == 0 \
+            and sp.simplify(woolley.xreplace(below) / crash.xreplace(below) - sp.cos(alpha)) == 0
+        ok_cap &= sp.simplify(crash.xreplace(cap) - 2 * E_crush) == 0 \
+            and sp.simplify(woolley.xreplace(cap) - sp.sqrt(2) * E_crush) == 0
+    capped = KERNELS[0].expanded(alpha_c)
+    samples = {sp.Rational(3, 10): sp.Rational(3, 10), -sp.Rational(3, 10): sp.Rational(3, 10),
+               sp.Rational(6, 5): PDOF_CAP, -sp.Rational(6, 5): PDOF_CAP}
+    ok_clamp = all(capped.xreplace({alpha: a}) == want for a, want in samples.items())
+    return [("crash3: below the cap E = E_crush/cos^2(alpha) (CRASH3) and E_woolley = "
+             "E_crush/cos(alpha) = cos(alpha) E (Woolley)", ok_below),
+            ("crash3: at the EDCRASH cap (45 deg) E = 2 E_crush and E_woolley = sqrt(2) E_crush",
+             ok_cap),
+            ("crash3: the corrected angle is min(|alpha|, 45 deg)", ok_clamp)]
 
 
 def _one_dimensional_impulse():
@@ -241,9 +310,35 @@ def _delta_v_claims():
                 and sp.simplify(knl.expanded(mass_factor1) - rg1**2 / (rg1**2 + h1**2)) == 0))
     out.append(("crash3_delta_v: m1 dV1 = m2 dV2, and with equal PDOFs the vectors conserve "
                 "momentum", _momentum_claim(knl)))
+    out.append(("crash3_delta_v: the CG delta-V is gamma times the effective-mass delta-V "
+                "(dV_i = gamma_i dV_i_eff, dV_i_eff = |P|/(gamma_i m_i))",
+                all(sp.simplify(kn.expanded(dV - mf * dv_eff, frozenset({P}))) == 0
+                    for kn in (knl, KERNELS[7])
+                    for dV, mf, dv_eff in ((dV1, mass_factor1, dV1_eff),
+                                           (dV2, mass_factor2, dV2_eff)))))
+    out += _absorbed_claims(knl, impulse, lost)
     out.append(("crash3_delta_v: given the common-velocity rigid solution's PDOF and energy "
                 "loss it returns that solution's |P| exactly", _common_velocity_claim(knl)))
     return out
+
+
+def _absorbed_claims(dissipated: Kernel, impulse, lost):
+    """The "absorbed" kernel: E is the energy lost up to maximum crush (the 1-D
+    loss at e = 0, the relative kinetic energy at the approach), its |P| is
+    (1 + e) times the approach impulse, which is the 1-D impulse with
+    restitution e; for the same E the absorbed |P| is √(1 - e²) times the
+    dissipated one."""
+    knl = KERNELS[7]
+    p_abs = knl.expanded(P, frozenset({ke1, ke2}))
+    approach_loss = lost.xreplace({e: 0})
+    full = sp.simplify(p_abs.xreplace({E: approach_loss})**2 - impulse**2)
+    total = sp.simplify(impulse - (1 + e) * impulse.xreplace({e: 0}))
+    ratio = p_abs / dissipated.expanded(P, frozenset({ke1, ke2}))
+    return [("crash3_delta_v_absorbed: with E the energy absorbed to maximum crush, |P| is the "
+             "1-D impulse with restitution e, (1 + e) times the approach impulse",
+             full == 0 and total == 0),
+            ("crash3_delta_v_absorbed: for the same E, |P|_absorbed = sqrt(1 - e^2) "
+             "|P|_dissipated", sp.simplify(ratio**2 - (1 - e**2)) == 0)]
 
 
 def _momentum_claim(knl: Kernel) -> bool:

@@ -139,6 +139,7 @@ INVERSE_MODELS = ("rigid", "particle")
 
 CRASH3_ENERGY = {n: _kernel_set(crash3, f"crash3_energy_{n}") for n in (2, 4, 6)}
 CRASH3_DELTA_V = _kernel_set(crash3, "crash3_delta_v")
+CRASH3_DELTA_V_ABSORBED = _kernel_set(crash3, "crash3_delta_v_absorbed")
 CRASH3_MOMENT_ARM = _kernel_set(crash3, "crash3_moment_arm")
 CRASH3_RADIUS_OF_GYRATION = _kernel_set(crash3, "crash3_radius_of_gyration")
 CRASH3_IMPLIED_PDOF = _kernel_set(crash3, "crash3_implied_pdof")

@@ -18,15 +18,14 @@ from __future__ import annotations
 import numpy as np
 
 from . import _kernels
+from ._util import CHUNK_SIZE, is_dataframe, row_count, spans
+from .dask_engine import map_chunks
 from .scene import CRITICAL
 
 
-def _is_dataframe(obj) -> bool:
-    return type(obj).__module__.startswith("pandas") and hasattr(obj, "columns")
-
-
-def _as_column(columns, name: str, n: int | None):
-    """One input column: a float (a scalar column) or a 1-D float64 array."""
+def _as_column(columns, name: str):
+    """One input column: a float (a scalar column) or a 1-D float64 array
+    (its length already checked by `row_count`)."""
     if name not in columns:
         raise ValueError(f"{name}: missing column")
     try:
@@ -37,16 +36,7 @@ def _as_column(columns, name: str, n: int | None):
         return float(arr)
     if arr.ndim > 1:
         raise ValueError(f"{name}: must be one-dimensional, got shape {arr.shape}")
-    if n is not None and arr.shape[0] != n:
-        raise ValueError(f"{name}: length {arr.shape[0]} differs from the other columns ({n})")
     return arr
-
-
-def _row_count(columns, names) -> int:
-    """The common length of the array columns (1 if all are scalars)."""
-    lengths = {np.ndim(columns[k]) and len(columns[k]) for k in names if k in columns}
-    lengths.discard(0)
-    return max(lengths) if lengths else 1
 
 
 def run_columns(ks: _kernels.KernelSet, columns, outputs, placeholders=()):
@@ -59,8 +49,8 @@ def run_columns(ks: _kernels.KernelSet, columns, outputs, placeholders=()):
 def _run(ks: _kernels.KernelSet, columns, outputs, placeholders) -> dict:
     """Validate `columns` for kernel `ks`, run it, collect `outputs` (a dict)."""
     names = [k for k in ks.inputs if k not in placeholders]
-    n = _row_count(columns, names)
-    inputs = [0.0 if name in placeholders else _as_column(columns, name, n)
+    n = row_count(columns, names)
+    inputs = [0.0 if name in placeholders else _as_column(columns, name)
               for name in ks.inputs]
     return _collect(ks, *_kernels.run_batch(ks, inputs, n), outputs, n)
 
@@ -79,7 +69,7 @@ def _collect(ks, outs, status, flags, outputs, n) -> dict:
 
 def _like(columns, result: dict):
     """`result` as a DataFrame with the columns' index when they were one."""
-    if _is_dataframe(columns):
+    if is_dataframe(columns):
         import pandas as pd
 
         return pd.DataFrame(result, index=columns.index)
@@ -121,8 +111,6 @@ def solve_batch(columns, model="rigid", outputs=None, engine: str = "local"):
     """
     names, tier = _kernels.requested_outputs(outputs)
     if engine == "dask":
-        from .dask_engine import solve_batch_dask
-
         return solve_batch_dask(columns, model=model, outputs=outputs)
     if engine != "local":
         raise ValueError(f"engine: unknown engine {engine!r} (use local or dask)")
@@ -130,6 +118,33 @@ def solve_batch(columns, model="rigid", outputs=None, engine: str = "local"):
     if isinstance(models, str) and not isinstance(critical, np.ndarray):
         return _like(columns, _solve_group(columns, models, critical, names, tier, mixed=False))
     return _like(columns, _solve_mixed(columns, models, critical, names, tier))
+
+
+def solve_batch_dask(columns, model="rigid", outputs=None, chunk_size: int = CHUNK_SIZE):
+    """`solve_batch` over chunks of ``chunk_size`` rows as dask tasks
+    (`dask_engine.map_chunks`): the same arguments (``model`` a name or one
+    per row) and the same result (a dict, or a DataFrame with the input's
+    index) as the local engine. Each chunk is sent to the cluster ahead of
+    its task, not embedded in the task graph."""
+    data = {name: columns[name].to_numpy() if is_dataframe(columns) else columns[name]
+            for name in columns}
+    n = row_count({**data, "model": model})
+    chunks = ((_rows(data, *span), _rows({"model": model}, *span)["model"])
+              for span in spans(n, chunk_size))
+    parts = list(map_chunks(_solve_chunk, outputs, chunks, scatter_items=True))
+    return _like(columns, {name: np.concatenate([part[name] for part in parts]) for name in parts[0]})
+
+
+def _solve_chunk(outputs, chunk: tuple) -> dict:
+    """A dask task: `solve_batch` with the local engine on one chunk, (columns, model)."""
+    columns, model = chunk
+    return solve_batch(columns, model=model, outputs=outputs, engine="local")
+
+
+def _rows(columns: dict, start: int, stop: int) -> dict:
+    """Rows start..stop-1 of every array column; scalars stay scalars."""
+    return {name: column if np.ndim(column) == 0 else column[start:stop]
+            for name, column in columns.items()}
 
 
 def _row_models(columns, model):
@@ -141,7 +156,7 @@ def _row_models(columns, model):
         uniq = set(model.tolist())
         if len(uniq) == 1:
             model = uniq.pop()
-    mu = columns["mu"] if "mu" in columns else None
+    mu = columns.get("mu")
     if isinstance(mu, str):
         if mu != CRITICAL:
             raise ValueError(f"mu: a number or {CRITICAL!r}, got {mu!r}")
@@ -182,7 +197,7 @@ def _no_moment(columns) -> bool:
 
 def _solve_mixed(columns, models, critical, names, tier: str) -> dict:
     """Group rows by (model, critical), solve each group, scatter back in order."""
-    n = _row_count(columns, list(columns))
+    n = row_count(columns)
     model_rows = np.broadcast_to(np.asarray(models, dtype=object), (n,))
     crit_rows = np.broadcast_to(np.asarray(critical, dtype=bool), (n,))
     keys = np.array([f"{m}\0{int(c)}" for m, c in zip(model_rows.tolist(), crit_rows.tolist())])

@@ -115,18 +115,30 @@ def _run_invert(args: argparse.Namespace) -> int:
 
 
 def _add_crash3(parser: argparse.ArgumentParser) -> None:
-    """Arguments of ``crash3``: the scene file, ``--json`` and ``--restitution``."""
+    """Arguments of ``crash3``: the scene file, ``--json`` and the CRASH3 options
+    (``--restitution``, ``--energy``, ``--correction``), which override the
+    scene's ``"crash3"`` object. Values are checked by :func:`crash3` so that a
+    bad one is the same one-line error as in a scene."""
     _add_scene(parser)
-    parser.add_argument("--restitution", type=float, default=0.0, metavar="E",
-                        help="restitution e, 0 <= e < 1 (default 0: CRASH3's common velocity)")
+    parser.add_argument("--restitution", type=float, default=None, metavar="E",
+                        help="restitution e (default: the scene's, else 0: CRASH3's common velocity)")
+    parser.add_argument("--energy", default=None, metavar="MODE",
+                        help="what the crush energy is: dissipated (over the impact, default) or "
+                             "absorbed (to maximum crush; total delta-V = (1 + e) x approach)")
+    parser.add_argument("--correction", default=None, metavar="NAME",
+                        help="oblique correction: crash3 (1 + tan^2 alpha, default) or woolley "
+                             "(1/cos alpha); both capped at 45 degrees as EDCRASH does")
     uncertainty_cli.add_arguments(parser, plot=True)
 
 
 def _run_crash3(args: argparse.Namespace) -> int:
     """CRASH3 delta-V from the vehicles' crush tables; print JSON or a table."""
-    result = crash3(args.scene, restitution=args.restitution)
+    result = crash3(args.scene, restitution=args.restitution, energy=args.energy,
+                    correction=args.correction)
     if args.uncertainty:
-        return uncertainty_cli.run(args, "crash3", result, restitution=args.restitution)
+        return uncertainty_cli.run(args, "crash3", result, restitution=result.restitution,
+                                   energy=result.options.energy,
+                                   correction=result.options.correction)
     return _print_result(result, args.json)
 
 
@@ -146,8 +158,8 @@ def _run_compare(args: argparse.Namespace) -> int:
     if args.plot:
         try:
             result.plot(args.plot)
-        except ImportError:
-            raise UsageError("--plot needs matplotlib (pip install 'impactsym[plot]')") from None
+        except ImportError as exc:
+            raise UsageError(str(exc)) from None
     if args.markdown:
         print(result.markdown())
         return 0
@@ -350,6 +362,27 @@ def _summary_json(summary, plan) -> dict:
     }
 
 
+def _add_validate(parser: argparse.ArgumentParser) -> None:
+    """Arguments of ``validate``: ``--markdown`` and ``--plots DIR``."""
+    parser.add_argument("--markdown", action="store_true",
+                        help="print the whole report (statistics, per-row tables) as markdown")
+    parser.add_argument("--plots", metavar="DIR", default=None,
+                        help="save the predicted-versus-measured plots (PNG) in DIR (needs matplotlib)")
+
+
+def _run_validate(args: argparse.Namespace) -> int:
+    """The models against RICSAC, IIHS and NHTSA crash tests (impactsym/validation.py)."""
+    from . import validation
+
+    datasets = validation.report()
+    figures = None
+    if args.plots:
+        paths = validation.plot(datasets, args.plots)
+        figures = {ds.name: str(path) for ds, path in zip(datasets, paths)}
+    print(validation.markdown(datasets, figures) if args.markdown else validation.text_summary(datasets))
+    return 0
+
+
 COMMANDS: dict[str, Command] = {
     "solve": Command(
         "solve the impact of a scene (initial motion -> final motion, impulses, energy loss)",
@@ -386,6 +419,11 @@ COMMANDS: dict[str, Command] = {
         "Monte Carlo: draw inputs from distributions around a scene, print percentiles",
         _add_sample,
         _run_sample,
+    ),
+    "validate": Command(
+        "run the models against published crash tests (RICSAC, IIHS, NHTSA) and report the errors",
+        _add_validate,
+        _run_validate,
     ),
 }
 

@@ -26,8 +26,8 @@ status meaning
 10     reconstruction: a vehicle is fixed (its momentum is undefined)
 11     CRASH3: a crush input is out of range (A < 0, B <= 0, width <= 0 or a
        negative depth)
-12     CRASH3: the PDOF is more than 45° from the normal of the damaged face,
-       beyond the limit of the 1 + tan²α energy correction
+12     CRASH3: the PDOF is 90° or more from the inward normal of the damaged
+       face (the force would pull the face out)
 ====== ======================================================================
 
 ====== ======================================================================
@@ -41,6 +41,8 @@ flag   meaning (bits add up)
 16     (reconstruction) a speed is negative: the vehicle moved against its heading
 32     (reconstruction) the headings are within about 6° of collinear
        (|sin(θ1 - θ2)| < 0.1): the speeds are sensitive to the headings
+64     (CRASH3) the PDOF is more than 45° from the normal of the damaged face:
+       the oblique correction was capped at 45° (EDCRASH caps 1 + tan²α at 2)
 ====== ======================================================================
 """
 
@@ -55,6 +57,7 @@ FLAG_MU_BEYOND_CRITICAL = _codes.FLAG_MU_BEYOND_CRITICAL
 FLAG_E_OUT_OF_RANGE = _codes.FLAG_E_OUT_OF_RANGE
 FLAG_NEGATIVE_SPEED = _codes.FLAG_NEGATIVE_SPEED
 FLAG_HEADINGS_ILL_CONDITIONED = _codes.FLAG_HEADINGS_ILL_CONDITIONED
+FLAG_PDOF_CAPPED = _codes.FLAG_PDOF_CAPPED
 
 STATUS_MESSAGES = {
     _codes.STATUS_OK: "solved",
@@ -83,8 +86,8 @@ STATUS_MESSAGES = {
     "pre-impact yaw rates (impactsym reconstruct) or use e_m = 1 (no moment impulse)",
     _codes.STATUS_BAD_CRUSH: "a CRASH3 crush input is out of range: A must be >= 0, B and "
     "the width > 0, every depth >= 0",
-    _codes.STATUS_PDOF_BEYOND_LIMIT: "the PDOF is more than 45 degrees from the normal of the "
-    "damaged face: CRASH3's 1 + tan^2(alpha) energy correction is not valid there",
+    _codes.STATUS_PDOF_BEYOND_LIMIT: "the PDOF is 90 degrees or more from the inward normal of "
+    "the damaged face: the force would pull the face out",
 }
 
 FLAG_MESSAGES = {
@@ -99,6 +102,8 @@ FLAG_MESSAGES = {
     "against its stated heading",
     FLAG_HEADINGS_ILL_CONDITIONED: "the headings are within about 6 degrees of collinear: "
     "the reconstructed speeds are very sensitive to the headings",
+    FLAG_PDOF_CAPPED: "the PDOF is more than 45 degrees from the normal of the damaged face: "
+    "the oblique energy correction was capped at 45 degrees (EDCRASH caps 1 + tan^2(alpha) at 2)",
 }
 
 

@@ -8,8 +8,11 @@
   coincide by construction (seed Table 7);
 - ``impac_sideswipe`` runs when the scene gives ``impact.slip`` (at slip = 0 it
   is ``impac``);
-- ``crash3`` runs when every moving vehicle carries a ``crush`` table (its
-  restitution is 0: common velocity).
+- ``crash3`` runs when every moving vehicle carries a ``crush`` table, with the
+  scene's ``"crash3"`` options (default restitution 0: common velocity). A
+  crush-only scene (no velocities or no impact block) gives the CRASH3 row
+  alone, without final velocities or energy percentages, and lists every
+  impulse-momentum model as skipped with the reason.
 
 Each row gives the final velocity of each vehicle as speed and direction
 (degrees counter-clockwise from +x), the final yaw rate, delta-V, and the energy
@@ -31,9 +34,10 @@ from typing import Any, Union
 from generated.presets import PRESETS
 
 from . import _kernels
+from ._util import require
 from .crash3 import crash3
 from .result import UNIT_LABELS, Result
-from .scene import Scene, SceneError, load_scene, scene_data, uses_yaw
+from .scene import Scene, SceneError, _mapping, load_scene, scene_data, uses_yaw
 from .single import solve
 
 __all__ = ["compare", "Comparison", "ModelRow", "COMPARED_MODELS"]
@@ -50,17 +54,19 @@ class VehicleRow:
     """One vehicle in one model: final velocity [m/s | ft/s] and its speed and
     direction [deg], final yaw rate [rad/s] (None: the model has none), delta-V."""
 
-    velocity: tuple[float, float]
-    speed: float
-    direction: float
+    velocity: tuple[float, float] | None
+    speed: float | None
+    direction: float | None
     yaw_rate: float | None
     delta_v: tuple[float, float]
     delta_v_magnitude: float
 
     def to_json_dict(self) -> dict[str, Any]:
         """The vehicle entry of a model in ``compare --json``."""
-        return {"velocity": list(self.velocity), "speed": self.speed, "direction": self.direction,
-                "yaw_rate": self.yaw_rate, "delta_v": list(self.delta_v),
+        return {"velocity": None if self.velocity is None else list(self.velocity),
+                "speed": self.speed, "direction": self.direction,
+                "yaw_rate": self.yaw_rate,
+                "delta_v": None if self.delta_v is None else list(self.delta_v),
                 "delta_v_magnitude": self.delta_v_magnitude}
 
 
@@ -90,11 +96,12 @@ class ModelRow:
 
 @dataclass(frozen=True)
 class Comparison:
-    """Every model the scene allows, with the initial kinetic energy [J | ft·lb]."""
+    """Every model the scene allows, with the initial kinetic energy [J | ft·lb]
+    (None for a crush-only scene)."""
 
     units: str
     names: tuple[str, str]
-    initial_kinetic_energy: float
+    initial_kinetic_energy: float | None
     rows: tuple[ModelRow, ...]
     skipped: dict[str, str]
 
@@ -117,7 +124,8 @@ class Comparison:
         for row in self.rows:
             cells = [row.model]
             for veh in row.vehicles:
-                cells += [f"{veh.speed:.2f} / {veh.direction:.1f}°", _cell(veh.yaw_rate, ".2f"),
+                speed = "n/a" if veh.speed is None else f"{veh.speed:.2f} / {veh.direction:.1f}°"
+                cells += [speed, _cell(veh.yaw_rate, ".2f"),
                           _cell(veh.delta_v_magnitude, ".2f")]
             cells += [_cell(row.energy_percent[part], ".1f") for part in _ENERGY_PARTS]
             body.append(cells)
@@ -127,9 +135,10 @@ class Comparison:
         """A plain-text table for people (like the seed's Tables 5-8)."""
         headers, body = self._cells()
         widths = [max(len(h), *(len(r[i]) for r in body)) for i, h in enumerate(headers)]
+        initial = ("unknown (no pre-impact motion)" if self.initial_kinetic_energy is None
+                   else f"{self.initial_kinetic_energy:.6g} {UNIT_LABELS[self.units]['energy']}")
         lines = [f"model comparison, {self.units} units; energy as % of the initial kinetic "
-                 f"energy {self.initial_kinetic_energy:.6g} {UNIT_LABELS[self.units]['energy']}",
-                 ""]
+                 f"energy {initial}", ""]
         for cells in [headers] + body:
             lines.append("  ".join(c.rjust(wd) if i else c.ljust(wd)
                                    for i, (c, wd) in enumerate(zip(cells, widths))))
@@ -150,7 +159,7 @@ class Comparison:
         """Bar charts of |delta-V| per vehicle and of the energy loss (% of the
         initial kinetic energy, stacked normal/tangential/moment) by model, saved
         to `path` (needs matplotlib: ``pip install 'impactsym[plot]'``)."""
-        import matplotlib
+        matplotlib = require("matplotlib", extra="plot", what="compare --plot")
 
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
@@ -168,8 +177,8 @@ class Comparison:
             heights = [row.energy_percent[part] or 0.0 for row in self.rows]
             ax_e.bar(x, heights, 0.6, bottom=bottom, label=part)
             bottom = [b + h for b, h in zip(bottom, heights)]
-        crash = [row.energy_percent["total"] if row.energy_percent["normal"] is None else 0.0
-                 for row in self.rows]
+        crash = [(row.energy_percent["total"] or 0.0) if row.energy_percent["normal"] is None
+                 else 0.0 for row in self.rows]
         ax_e.bar(x, crash, 0.6, label="crush energy (CRASH3)", hatch="//")
         ax_e.set_ylabel("energy loss [% of initial kinetic energy]")
         ax_e.margins(y=0.25)
@@ -184,10 +193,17 @@ class Comparison:
 
 def compare(scene: Union[Scene, Mapping, str, Path]) -> Comparison:
     """Run a forward scene through every model its data allow (see the module
-    docstring). Raises :class:`SceneError` when the scene itself is not a valid
-    forward scene or no model can solve it."""
+    docstring); a crush-only scene gives the CRASH3 row alone. Raises
+    :class:`SceneError` when the scene is neither a valid forward scene nor a
+    CRASH3 scene, or no model can solve it."""
     data = scene_data(scene)
-    base = _base_scene(data)
+    try:
+        base = _base_scene(data)
+    except SceneError as exc:
+        return _crush_only(data, exc)
+    # every model sees the normal in the sense the geometry chose (the particle
+    # model has no impact points to choose it by)
+    data = {**data, "impact": {**data["impact"], "normal_angle": base.impact.normal_angle}}
     initial = _initial_kinetic_energy(base)
     rows, skipped = [], {}
     for name in COMPARED_MODELS:
@@ -201,6 +217,30 @@ def compare(scene: Union[Scene, Mapping, str, Path]) -> Comparison:
                          + "; ".join(f"{n}: {r}" for n, r in skipped.items()))
     names = (base.vehicles[0].name, base.vehicles[1].name)
     return Comparison(base.units, names, initial, tuple(rows), skipped)
+
+
+def _crush_only(data: Mapping, forward_error: SceneError) -> Comparison:
+    """A scene that is not a forward scene: the CRASH3 row alone when it is a
+    CRASH3 scene (the forward error is re-raised when it is not)."""
+    try:
+        scene = load_scene(data, kind="crash3")
+    except SceneError:
+        raise forward_error from None
+    result = crash3(data)
+    rows = (ModelRow("crash3", CRASH3_ASSUMPTIONS,
+                     tuple(_vehicle_row(None, None, c.delta_v, c.delta_v_magnitude)
+                           for c in result.vehicles),
+                     _crash3_energy(result), _percent(_crash3_energy(result), None), None, None,
+                     [w for w in result.warnings if w not in scene.warnings]),)
+    reason = f"needs a forward scene (pre-impact motion and impact geometry): {forward_error}"
+    skipped = {name: reason for name in COMPARED_MODELS if name != "crash3"}
+    names = (scene.vehicles[0].name, scene.vehicles[1].name)
+    return Comparison(scene.units, names, None, rows, skipped)
+
+
+def _crash3_energy(result) -> dict[str, float | None]:
+    """CRASH3's energy: the crush energy total, no parts."""
+    return {"total": result.energy_total, "normal": None, "tangential": None, "moment": None}
 
 
 def _base_scene(data: Mapping) -> Scene:
@@ -220,7 +260,7 @@ def _variant(data: Mapping, model: str) -> dict:
     fixes or does not use are left out (so they raise no warnings)."""
     preset = PRESETS[model]
     used = ("normal_angle", *preset["required"], *preset["optional"])
-    impact = {k: v for k, v in data["impact"].items() if k in used}
+    impact = {k: v for k, v in _mapping(data.get("impact", {}), "impact").items() if k in used}
     return {**data, "model": model, "impact": impact}
 
 
@@ -250,13 +290,17 @@ def _crash3_row(data: Mapping, base: Scene, initial: float) -> ModelRow:
         _vehicle_row((v.velocity[0] + c.delta_v[0], v.velocity[1] + c.delta_v[1]), None,
                      c.delta_v, c.delta_v_magnitude)
         for v, c in zip(base.vehicles, result.vehicles))
-    energy = {"total": result.energy_total, "normal": None, "tangential": None, "moment": None}
+    energy = _crash3_energy(result)
     return ModelRow("crash3", CRASH3_ASSUMPTIONS, vehicles, energy, _percent(energy, initial),
                     None, None, [w for w in result.warnings if w not in base.warnings])
 
 
 def _vehicle_row(velocity, yaw_rate, delta_v, magnitude) -> VehicleRow:
-    """Final velocity also as speed and direction (degrees from +x)."""
+    """Final velocity also as speed and direction (degrees from +x); None
+    without a final velocity (crush-only CRASH3)."""
+    if velocity is None:
+        return VehicleRow(None, None, None, yaw_rate, None if delta_v is None else tuple(delta_v),
+                          magnitude)
     return VehicleRow(velocity=tuple(velocity), speed=math.hypot(*velocity),
                       direction=math.degrees(math.atan2(velocity[1], velocity[0])),
                       yaw_rate=yaw_rate, delta_v=tuple(delta_v), delta_v_magnitude=magnitude)
@@ -277,9 +321,10 @@ def _initial_kinetic_energy(scene: Scene) -> float:
     return out["T"]
 
 
-def _percent(energy: Mapping[str, float | None], initial: float) -> dict[str, float | None]:
-    """Each energy as a percent of the initial kinetic energy (None stays None)."""
-    return {k: None if v is None or initial <= 0.0 else 100.0 * v / initial
+def _percent(energy: Mapping[str, float | None], initial: float | None) -> dict[str, float | None]:
+    """Each energy as a percent of the initial kinetic energy (None stays None;
+    all None without an initial kinetic energy)."""
+    return {k: None if v is None or initial is None or initial <= 0.0 else 100.0 * v / initial
             for k, v in energy.items()}
 
 

@@ -1,9 +1,10 @@
 """CRASH3: delta-V from crush energy, and its inconsistency with impulse-momentum.
 
 The formulas are derive/crash3.py's (emitted to generated/crash3.py): crush energy
-of each vehicle from its damage profile, the PDOF correction 1 + tan²α
-(|α| ≤ 45°), the effective-mass factor γ = k²/(k² + h²), and delta-V from the
-total energy with a common velocity (restitution e = 0 unless given).
+of each vehicle from its damage profile, the oblique correction (CRASH3's
+1 + tan²α or Woolley's 1/cos α, capped at α = 45° as EDCRASH does), the
+effective-mass factor γ = k²/(k² + h²), and delta-V from the total energy with
+a common velocity (restitution e = 0 unless given).
 
 A vehicle's ``crush`` table (scene file):
 
@@ -16,7 +17,35 @@ A vehicle's ``crush`` table (scene file):
   normal is -n for vehicle 1 and +n for vehicle 2, and the force on vehicle 1
   points along Γ + 180° + α (on vehicle 2 along Γ + α);
 - optional ``moment_arm`` [m | ft] (h, the distance from the centre of gravity
-  to the PDOF line) and ``radius_of_gyration`` [m | ft] (k).
+  to the PDOF line) and ``radius_of_gyration`` [m | ft] (k);
+- instead of ``A`` and ``B``: ``category`` (1-9) and ``face`` (``front``,
+  ``rear``, ``side``), the EDCRASH default stiffness of
+  :mod:`impactsym.crash3_tables` (Day & Hargens, SAE 870045); a scene may mix
+  categories and explicit A, B; ``class`` (1-7, 10) supplies the class default
+  k² when the vehicle has no ``yaw_inertia`` and no ``radius_of_gyration``.
+
+Options (the scene's top-level ``"crash3"`` object; the arguments of
+:func:`crash3` and the CLI flags of the same names override it):
+
+- ``restitution`` e (default 0: CRASH3's common velocity);
+- ``energy``: ``"dissipated"`` (default: the crush energy is the energy lost
+  over the whole impact, |P| = √(2 E m̄ (1 + e)/(1 - e))) or ``"absorbed"`` (the
+  crush energy is absorbed up to maximum crush: the approach delta-V comes from
+  it, |P| = (1 + e)·√(2 E m̄); Rose, Fenton & Beauchamp, SAE 2006-01-0908);
+- ``correction``: ``"crash3"`` (default, E·(1 + tan²α)) or ``"woolley"``
+  (E/cos α). Both are capped as EDCRASH caps CRASH3's factor at 2: the angle
+  is taken as min(|α|, 45°) and a capped vehicle gets a warning; |α| ≥ 90° is
+  an error.
+
+Which delta-V: ``delta_v_magnitude`` is the change of velocity of the centre of
+gravity, |P|/m (what Brach, Neades and Rose report and a CG accelerometer
+measures). ``delta_v_effective_mass`` is EDCRASH's printed value, the change of
+velocity of the effective mass γ·m, |P|/(γ m); the two are related by
+ΔV_cg = γ·ΔV_eff with γ = k²/(k² + h²) (derive/crash3.py proves it).
+
+A crash3 scene needs no ``impact`` block: without it the delta-V has no
+direction in the scene frame (``delta_v`` is null), moment arms must be given
+as ``moment_arm`` (or are 0), and there is no impulse-momentum comparison.
 
 Units: SI crush inputs give joules. US crush inputs are CRASH3's lb/in, lb/in²
 and in (pounds of force; masses stay in slugs): their energy is in in·lb and is
@@ -43,16 +72,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Union
 
-from generated.codes import STATUS_PDOF_BEYOND_LIMIT
+from generated.codes import FLAG_PDOF_CAPPED
 
 from . import _kernels
 from .codes import describe_status
-from .result import UNIT_LABELS
+from .crash3_tables import CLASSES, FACES, class_dimensions, stiffness
+from .result import UNIT_LABELS, road_speed_rows
 from .scene import Scene, SceneError, Vehicle, _mapping, _number, _positive, load_scene, scene_data
 from .single import solve
 
-__all__ = ["crash3", "Crash3Result", "Crash3Vehicle", "Crush", "INCHES_PER_FOOT",
-           "PDOF_MISMATCH_DEG"]
+__all__ = ["crash3", "Crash3Result", "Crash3Vehicle", "Crash3Options", "Crush", "INCHES_PER_FOOT",
+           "PDOF_MISMATCH_DEG", "ENERGY_MODES", "CORRECTIONS", "PDOF_CAP_DEG"]
 
 INCHES_PER_FOOT = 12.0
 # Energy of crush inputs in the scene's energy unit: SI J per (N/m·m²), US ft·lb per in·lb.
@@ -60,8 +90,32 @@ ENERGY_FACTOR = {"SI": 1.0, "US": 1.0 / INCHES_PER_FOOT}
 PROFILE_SIZES = tuple(_kernels.CRASH3_ENERGY)
 # Entered and implied PDOFs further apart than this are reported as a warning [deg].
 PDOF_MISMATCH_DEG = 5.0
-PDOF_LIMIT_DEG = 45.0
-CRUSH_KEYS = ("A", "B", "width", "depths", "pdof", "moment_arm", "radius_of_gyration")
+PDOF_CAP_DEG = 45.0    # EDCRASH: the correction factor 1 + tan²α is capped at 2
+PDOF_LIMIT_DEG = 90.0  # beyond it the force would pull the damaged face out
+CRUSH_KEYS = ("A", "B", "width", "depths", "pdof", "moment_arm", "radius_of_gyration",
+              "category", "face", "class")
+ENERGY_MODES = ("dissipated", "absorbed")
+CORRECTIONS = ("crash3", "woolley")
+OPTION_KEYS = ("restitution", "energy", "correction")
+# The energy kernel's output for each correction.
+_CORRECTED = {"crash3": "E", "woolley": "E_woolley"}
+_DELTA_V = {"dissipated": _kernels.CRASH3_DELTA_V, "absorbed": _kernels.CRASH3_DELTA_V_ABSORBED}
+# Inches per scene length unit, for class k² (published in in²).
+_INCHES_PER_LENGTH = {"SI": 1.0 / 0.0254, "US": INCHES_PER_FOOT}
+
+
+@dataclass(frozen=True)
+class Crash3Options:
+    """CRASH3 options (module docstring): restitution e, what the crush energy
+    is (``energy``) and the oblique correction (``correction``)."""
+
+    restitution: float = 0.0
+    energy: str = "dissipated"
+    correction: str = "crash3"
+
+    def to_json_dict(self) -> dict[str, Any]:
+        return {"restitution": self.restitution, "energy": self.energy,
+                "correction": self.correction}
 
 
 @dataclass(frozen=True)
@@ -75,6 +129,7 @@ class Crush:
     pdof: float
     moment_arm: float | None = None
     radius_of_gyration: float | None = None
+    vehicle_class: int | None = None
 
 
 @dataclass(frozen=True)
@@ -82,7 +137,10 @@ class Crash3Vehicle:
     """CRASH3 outcome for one vehicle: energies [J | ft·lb], PDOF [deg],
     effective-mass factor γ, moment arm [m | ft], delta-V [m/s | ft/s] along
     the PDOF. ``pdof_implied`` [deg] and ``delta_v_magnitude_impulse_momentum``
-    come from the common-velocity impulse-momentum solution (None without it)."""
+    come from the common-velocity impulse-momentum solution (None without it).
+    ``delta_v_magnitude`` is the centre-of-gravity delta-V, ``delta_v_effective_mass``
+    EDCRASH's effective-mass delta-V (= delta_v_magnitude / mass_factor);
+    ``delta_v`` is None without an impact block (no scene-frame direction)."""
 
     name: str
     crush_energy: float
@@ -90,8 +148,9 @@ class Crash3Vehicle:
     pdof: float
     mass_factor: float
     moment_arm: float
-    delta_v: tuple[float, float]
+    delta_v: tuple[float, float] | None
     delta_v_magnitude: float
+    delta_v_effective_mass: float
     pdof_implied: float | None = None
     delta_v_magnitude_impulse_momentum: float | None = None
 
@@ -101,7 +160,9 @@ class Crash3Vehicle:
             "name": self.name, "crush_energy": self.crush_energy,
             "crush_energy_uncorrected": self.crush_energy_uncorrected, "pdof": self.pdof,
             "effective_mass_factor": self.mass_factor, "moment_arm": self.moment_arm,
-            "delta_v": list(self.delta_v), "delta_v_magnitude": self.delta_v_magnitude,
+            "delta_v": None if self.delta_v is None else list(self.delta_v),
+            "delta_v_magnitude": self.delta_v_magnitude,
+            "delta_v_effective_mass": self.delta_v_effective_mass,
             "pdof_implied": self.pdof_implied,
             "delta_v_magnitude_impulse_momentum": self.delta_v_magnitude_impulse_momentum,
         }
@@ -113,15 +174,22 @@ class Crash3Result:
     magnitude |P| [N·s | lb·s], in the scene's units."""
 
     units: str
-    restitution: float
+    options: Crash3Options
     vehicles: tuple[Crash3Vehicle, Crash3Vehicle]
     energy_total: float
     impulse: float
     warnings: list[str] = field(default_factory=list)
 
+    @property
+    def restitution(self) -> float:
+        return self.options.restitution
+
     def to_json_dict(self) -> dict[str, Any]:
         """The object printed by ``impactsym crash3 --json`` (conventions.md)."""
         return {"units": self.units, "restitution": self.restitution,
+                "options": self.options.to_json_dict(),
+                "delta_v_reported": "centre of gravity (|P|/m); delta_v_effective_mass is "
+                                    "|P|/(gamma m) = delta_v_magnitude/gamma",
                 "vehicles": [v.to_json_dict() for v in self.vehicles],
                 "energy_total": self.energy_total, "impulse": self.impulse,
                 "warnings": list(self.warnings)}
@@ -134,17 +202,24 @@ class Crash3Result:
         rows = [
             (f"crush energy [{energy}]", one.crush_energy_uncorrected, two.crush_energy_uncorrected),
             ("PDOF alpha [deg]", one.pdof, two.pdof),
-            (f"  with 1 + tan^2(alpha) [{energy}]", one.crush_energy, two.crush_energy),
+            (f"  corrected ({self.options.correction}) [{energy}]", one.crush_energy,
+             two.crush_energy),
             ("effective-mass factor gamma", one.mass_factor, two.mass_factor),
-            (f"|delta-V| [{speed}]", one.delta_v_magnitude, two.delta_v_magnitude),
-            (f"delta-V x [{speed}]", one.delta_v[0], two.delta_v[0]),
-            (f"delta-V y [{speed}]", one.delta_v[1], two.delta_v[1]),
+            (f"|delta-V| of the CG [{speed}]", one.delta_v_magnitude, two.delta_v_magnitude),
+            (f"|delta-V| effective mass [{speed}]", one.delta_v_effective_mass,
+             two.delta_v_effective_mass),
+            *road_speed_rows(self.units, [("|delta-V| of the CG", (one.delta_v_magnitude,
+                                                                   two.delta_v_magnitude))]),
+            (f"delta-V x [{speed}]", *(v.delta_v and v.delta_v[0] for v in self.vehicles)),
+            (f"delta-V y [{speed}]", *(v.delta_v and v.delta_v[1] for v in self.vehicles)),
             ("PDOF implied by impulse-momentum [deg]", one.pdof_implied, two.pdof_implied),
             (f"|delta-V| impulse-momentum [{speed}]", one.delta_v_magnitude_impulse_momentum,
              two.delta_v_magnitude_impulse_momentum),
         ]
         width = max(14, len(one.name) + 2, len(two.name) + 2)
-        lines = [f"CRASH3, {self.units} units, restitution e = {self.restitution:g}", "",
+        opts = self.options
+        lines = [f"CRASH3, {self.units} units, restitution e = {opts.restitution:g}, crush energy "
+                 f"{opts.energy}, {opts.correction} oblique correction", "",
                  f"{'':<40}{one.name:>{width}}{two.name:>{width}}"]
         lines += [f"{label:<40}{_cell(a):>{width}}{_cell(b):>{width}}" for label, a, b in rows]
         lines += ["", f"{'total energy [' + energy + ']':<40}{_cell(self.energy_total):>{width}}", ""]
@@ -153,102 +228,205 @@ class Crash3Result:
         return "\n".join(lines)
 
 
-def crash3(scene: Union[Scene, Mapping, str, Path], restitution: float = 0.0) -> Crash3Result:
+def crash3(scene: Union[Scene, Mapping, str, Path], restitution: float | None = None,
+           energy: str | None = None, correction: str | None = None) -> Crash3Result:
     """CRASH3 delta-V of a scene whose moving vehicles carry ``crush`` tables.
 
-    ``restitution`` e (0 ≤ e < 1; 0 is CRASH3's common velocity) relates the
-    crush energy to the closing speed: E = m̄'·v_c²·(1 - e²)/2. A fixed vehicle
-    (a barrier) needs no crush table and absorbs no energy. Raises
-    :class:`SceneError` for a bad scene, crush table or restitution.
+    ``restitution`` e (0 ≤ e < 1 dissipated, ≤ 1 absorbed), ``energy``
+    (``"dissipated"`` | ``"absorbed"``) and ``correction`` (``"crash3"`` |
+    ``"woolley"``) override the scene's ``"crash3"`` options (module
+    docstring). A fixed vehicle (a barrier) needs no crush table and absorbs no
+    energy. Raises :class:`SceneError` (one line, naming the field) for a bad
+    scene, crush table or option.
     """
     data = scene_data(scene)
     parsed = load_scene(data, kind="crash3")
-    e = _restitution(restitution)
-    gamma = math.radians(parsed.impact.normal_angle)
-    crush = [None if v.fixed else _parse_crush(v.extra["crush"], f"vehicles[{i}].crush")
+    options = _options(data, restitution, energy, correction)
+    geometry = not math.isnan(parsed.impact.normal_angle)
+    gamma = math.radians(parsed.impact.normal_angle) if geometry else 0.0
+    crush = [None if v.fixed else _parse_crush(v.extra["crush"], f"vehicles[{i}].crush", parsed.units)
              for i, v in enumerate(parsed.vehicles)]
-    energies = [_energy(c, parsed.units, f"vehicles[{i}].crush") if c else (0.0, 0.0)
-                for i, c in enumerate(crush)]
+    energies = [_energy(c, parsed.units, f"vehicles[{i}].crush", options.correction)
+                if c else (0.0, 0.0, False) for i, c in enumerate(crush)]
     alphas = [math.radians(c.pdof) if c else 0.0 for c in crush]
-    values = {"E": energies[0][1] + energies[1][1], "e": e, "gamma": gamma,
+    values = {"E": energies[0][1] + energies[1][1], "e": options.restitution, "gamma": gamma,
               "alpha1": alphas[0], "alpha2": alphas[1]}
     for number, (vehicle, c) in enumerate(zip(parsed.vehicles, crush), start=1):
         values[f"m{number}"] = math.inf if vehicle.fixed else vehicle.mass
-        values[f"rg{number}"] = _radius_of_gyration(vehicle, c)
-        values[f"h{number}"] = _moment_arm(vehicle, c, gamma)
-    out = _run(_kernels.CRASH3_DELTA_V, values, "cannot compute the CRASH3 delta-V")
-    implied = _implied(data, e)
-    vehicles = tuple(_vehicle(v, c, energies[i], out, values, i + 1, implied)
+        values[f"rg{number}"] = _radius_of_gyration(vehicle, c, parsed.units)
+        values[f"h{number}"] = _moment_arm(data, vehicle, c, gamma, geometry, number - 1)
+    out = _run(_DELTA_V[options.energy], values, "cannot compute the CRASH3 delta-V")
+    implied = _implied(data, options.restitution) if geometry else None
+    vehicles = tuple(_vehicle(v, c, energies[i], out, values, i + 1, implied, geometry)
                      for i, (v, c) in enumerate(zip(parsed.vehicles, crush)))
-    warnings = _warnings(vehicles, crush, implied) + _unknown_crush_keys(parsed) \
-        + list(parsed.warnings)
-    return Crash3Result(parsed.units, e, vehicles, values["E"], out["P"], warnings)
+    warnings = _capped(crush, energies, options.correction) + _warnings(vehicles, crush, implied) \
+        + _unknown_crush_keys(parsed) + list(parsed.warnings)
+    return Crash3Result(parsed.units, options, vehicles, values["E"], out["P"], warnings)
 
 
-def _restitution(value: Any) -> float:
-    """CRASH3's restitution option, 0 ≤ e < 1."""
-    e = _number(value, "restitution")
-    if not 0.0 <= e < 1.0:
-        raise SceneError(f"must be in [0, 1) for CRASH3, got {e:g}", "restitution")
+def _options(data: Mapping, restitution, energy, correction) -> Crash3Options:
+    """The scene's ``"crash3"`` options overridden by the arguments given (not None)."""
+    table = _mapping(data.get("crash3", {}), "crash3")
+    for key in table:
+        if key not in OPTION_KEYS:
+            raise SceneError(f"unknown CRASH3 option (use {', '.join(OPTION_KEYS)})", f"crash3.{key}")
+    given = {"restitution": restitution, "energy": energy, "correction": correction}
+    pick = {k: (v if v is not None else table.get(k)) for k, v in given.items()}
+    where = {k: (k if given[k] is not None else f"crash3.{k}") for k in given}
+    mode = _word(pick["energy"], where["energy"], ENERGY_MODES, "dissipated")
+    return Crash3Options(restitution=_restitution(pick["restitution"], where["restitution"], mode),
+                         energy=mode,
+                         correction=_word(pick["correction"], where["correction"], CORRECTIONS,
+                                          "crash3"))
+
+
+def _word(value: Any, path: str, allowed: tuple[str, ...], default: str) -> str:
+    """An option that is one of `allowed` (None: the default)."""
+    if value is None:
+        return default
+    if value not in allowed:
+        raise SceneError(f"must be one of {', '.join(allowed)}, got {_short(value)}", path)
+    return value
+
+
+def _restitution(value: Any, path: str = "restitution", energy: str = "dissipated") -> float:
+    """CRASH3's restitution: 0 ≤ e < 1 when the energy is dissipated (e = 1 would
+    dissipate nothing), 0 ≤ e ≤ 1 when it is absorbed to maximum crush."""
+    if value is None:
+        return 0.0
+    e = _number(value, path)
+    if energy == "dissipated" and not 0.0 <= e < 1.0:
+        raise SceneError(f"must be in [0, 1) when the crush energy is dissipated, got {e:g}", path)
+    if not 0.0 <= e <= 1.0:
+        raise SceneError(f"must be in [0, 1], got {e:g}", path)
     return e
 
 
-def _parse_crush(raw: Any, path: str) -> Crush:
-    """Validate a ``crush`` table (the kernels check ranges again)."""
+def _parse_crush(raw: Any, path: str, units: str = "SI") -> Crush:
+    """Validate a ``crush`` table; each bad entry is an error naming its field and
+    the rule it breaks (the kernels check the ranges again)."""
     data = _mapping(raw, path)
-    for key in ("A", "B", "width", "depths", "pdof"):
+    for key in ("width", "depths", "pdof"):
         if key not in data:
             raise SceneError("missing", f"{path}.{key}")
+    a, b = _stiffness(data, path, units)
     depths = data["depths"]
     if not isinstance(depths, list) or len(depths) not in PROFILE_SIZES:
         raise SceneError(f"must be a list of 2, 4 or 6 crush depths, got {_short(depths)}",
                          f"{path}.depths")
+    crush_depths = tuple(_number(c, f"{path}.depths[{i}]") for i, c in enumerate(depths))
+    for i, c in enumerate(crush_depths):
+        if c < 0.0:
+            raise SceneError(f"must be >= 0 (a crush depth), got {c:g}", f"{path}.depths[{i}]")
+    width = _number(data["width"], f"{path}.width")
+    if width <= 0.0:
+        raise SceneError(f"must be > 0 (the damage width), got {width:g}", f"{path}.width")
+    pdof = _number(data["pdof"], f"{path}.pdof")
+    if abs(pdof) >= PDOF_LIMIT_DEG:
+        raise SceneError(f"|pdof| = {abs(pdof):g} must be < {PDOF_LIMIT_DEG:g} degrees from the "
+                         "inward normal of the damaged face (the force must push the face in)",
+                         f"{path}.pdof")
     optional = {}
     if "moment_arm" in data:
         optional["moment_arm"] = _number(data["moment_arm"], f"{path}.moment_arm")
     if "radius_of_gyration" in data:
         optional["radius_of_gyration"] = _positive(data["radius_of_gyration"],
                                                    f"{path}.radius_of_gyration")
-    return Crush(A=_number(data["A"], f"{path}.A"), B=_number(data["B"], f"{path}.B"),
-                 width=_number(data["width"], f"{path}.width"),
-                 depths=tuple(_number(c, f"{path}.depths") for c in depths),
-                 pdof=_number(data["pdof"], f"{path}.pdof"), **optional)
+    if "class" in data:
+        if data["class"] not in CLASSES:
+            raise SceneError(f"must be one of {', '.join(map(str, CLASSES))}, got "
+                             f"{_short(data['class'])}", f"{path}.class")
+        optional["vehicle_class"] = data["class"]
+    return Crush(A=a, B=b, width=width, depths=crush_depths, pdof=pdof, **optional)
 
 
-def _energy(crush: Crush, units: str, path: str) -> tuple[float, float]:
-    """(crush energy, PDOF-corrected energy) in the scene's energy unit."""
+def _stiffness(data: Mapping, path: str, units: str) -> tuple[float, float]:
+    """(A, B) in the scene's units: given, or the category default for the face."""
+    explicit = [k for k in ("A", "B") if k in data]
+    by_category = [k for k in ("category", "face") if k in data]
+    if explicit and by_category:
+        raise SceneError(f"give either A and B or category and face, not both ({explicit[0]} and "
+                         f"{by_category[0]})", f"{path}.{by_category[0]}")
+    if by_category:
+        for key in ("category", "face"):
+            if key not in data:
+                raise SceneError(f"missing (category needs face: {', '.join(FACES)})",
+                                 f"{path}.{key}")
+        category, face = data["category"], data["face"]
+        if isinstance(category, bool) or not isinstance(category, int) or not 1 <= category <= 9:
+            raise SceneError(f"must be an integer 1-9, got {_short(category)}", f"{path}.category")
+        if face not in FACES:
+            raise SceneError(f"must be one of {', '.join(FACES)}, got {_short(face)}", f"{path}.face")
+        try:
+            table = stiffness(category, face, units)
+        except ValueError as exc:
+            raise SceneError(str(exc), f"{path}.face") from None
+        return table.A, table.B
+    for key in ("A", "B"):
+        if key not in data:
+            raise SceneError("missing (give A and B, or category and face)", f"{path}.{key}")
+    a, b = _number(data["A"], f"{path}.A"), _number(data["B"], f"{path}.B")
+    if a < 0.0:
+        raise SceneError(f"must be >= 0 (the force per unit width at zero crush), got {a:g}",
+                         f"{path}.A")
+    if b <= 0.0:
+        raise SceneError(f"must be > 0 (the slope of force per unit width against crush), got {b:g}",
+                         f"{path}.B")
+    return a, b
+
+
+def _energy(crush: Crush, units: str, path: str, correction: str) -> tuple[float, float, bool]:
+    """(crush energy, corrected energy, capped) in the scene's energy unit."""
     values = {"A": crush.A, "B": crush.B, "width": crush.width, "alpha": math.radians(crush.pdof)}
     values.update({f"C{i}": c for i, c in enumerate(crush.depths, start=1)})
     ks = _kernels.CRASH3_ENERGY[len(crush.depths)]
     out = _kernels.run_one(ks, values, ks.outputs)
-    if out["status"] == STATUS_PDOF_BEYOND_LIMIT:
-        raise SceneError(f"|pdof| = {abs(crush.pdof):g} > {PDOF_LIMIT_DEG:g} degrees: "
-                         f"{describe_status(out['status'])}", f"{path}.pdof")
     if out["status"]:
         raise SceneError(describe_status(out["status"]), path)
     factor = ENERGY_FACTOR[units]
-    return out["E_crush"] * factor, out["E"] * factor
+    return (out["E_crush"] * factor, out[_CORRECTED[correction]] * factor,
+            bool(out["flags"] & FLAG_PDOF_CAPPED))
 
 
-def _radius_of_gyration(vehicle: Vehicle, crush: Crush | None) -> float:
-    """k [m | ft]: given, from the yaw inertia, or inf (no rotation: γ = 1)."""
+def _capped(crush, energies, correction: str) -> list[str]:
+    """A warning per vehicle whose oblique correction was capped (EDCRASH)."""
+    cap = {"crash3": "1 + tan^2(alpha) <= 2", "woolley": "1/cos(alpha) <= sqrt(2)"}[correction]
+    return [f"vehicles[{i}].crush.pdof = {c.pdof:g} degrees: the oblique correction is capped at "
+            f"{PDOF_CAP_DEG:g} degrees ({cap}), as EDCRASH does"
+            for i, (c, energy) in enumerate(zip(crush, energies)) if c is not None and energy[2]]
+
+
+def _radius_of_gyration(vehicle: Vehicle, crush: Crush | None, units: str = "SI") -> float:
+    """k [m | ft]: given, from the yaw inertia, from the class default k², or inf
+    (no rotation: γ = 1)."""
     if crush is None:
         return math.inf
     if crush.radius_of_gyration is not None:
         return crush.radius_of_gyration
     if vehicle.yaw_inertia is None:
-        return math.inf
+        if crush.vehicle_class is None:
+            return math.inf
+        return math.sqrt(class_dimensions(crush.vehicle_class)["k_squared_in2"]) \
+            / _INCHES_PER_LENGTH[units]
     out = _run(_kernels.CRASH3_RADIUS_OF_GYRATION,
                {"mass": vehicle.mass, "inertia": vehicle.yaw_inertia}, "radius of gyration")
     return out["rg"]
 
 
-def _moment_arm(vehicle: Vehicle, crush: Crush | None, gamma: float) -> float:
-    """h [m | ft]: given, from the impact point and the PDOF, or 0."""
+def _moment_arm(data: Mapping, vehicle: Vehicle, crush: Crush | None, gamma: float,
+                geometry: bool, index: int) -> float:
+    """h [m | ft]: given, from the impact point and the PDOF (needs the impact
+    block), or 0."""
     if crush is None:
         return 0.0
     if crush.moment_arm is not None:
         return crush.moment_arm
+    if not geometry:
+        if "impact_point" in data["vehicles"][index]:
+            raise SceneError("missing: the moment arm from vehicles[{index}].impact_point needs the "
+                             "crush-surface angle (or give crush.moment_arm)".replace(
+                                 "{index}", str(index)), "impact.normal_angle")
+        return 0.0
     rx, ry = vehicle.impact_point
     out = _run(_kernels.CRASH3_MOMENT_ARM,
                {"rx": rx, "ry": ry, "theta": gamma + math.radians(crush.pdof)}, "moment arm")
@@ -280,15 +458,16 @@ def _implied(data: Mapping, e: float) -> dict | None:
 
 
 def _vehicle(vehicle: Vehicle, crush: Crush | None, energy, out, values, number: int,
-             implied: dict | None) -> Crash3Vehicle:
+             implied: dict | None, geometry: bool = True) -> Crash3Vehicle:
     """Vehicle ``number``'s result from its energies, the delta-V kernel's output and
     the implied impulse-momentum solution (a fixed vehicle: zero energy and delta-V)."""
     return Crash3Vehicle(
         name=vehicle.name, crush_energy=energy[1], crush_energy_uncorrected=energy[0],
         pdof=crush.pdof if crush else 0.0, mass_factor=out[f"mass_factor{number}"],
         moment_arm=values[f"h{number}"],
-        delta_v=(out[f"dV{number}x"], out[f"dV{number}y"]),
+        delta_v=(out[f"dV{number}x"], out[f"dV{number}y"]) if geometry else None,
         delta_v_magnitude=out[f"dV{number}"],
+        delta_v_effective_mass=out[f"dV{number}_eff"],
         pdof_implied=None if implied is None or vehicle.fixed else implied["pdof"],
         delta_v_magnitude_impulse_momentum=None if implied is None else implied["delta_v"][number - 1],
     )

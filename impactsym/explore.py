@@ -30,16 +30,14 @@ import math
 import time
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Optional, Union
+from typing import Any
 
+from ._util import require
 from .result import UNIT_LABELS
 from .scene import CRITICAL, Scene, SceneError, load_scene
 from .single import solve
 
-__all__ = ["explore", "Explorer", "INSTALL_HINT", "MU_RANGE_FACTOR"]
-
-INSTALL_HINT = ("impactsym.explore needs ipywidgets and matplotlib: pip install 'impactsym[explore]' "
-                "(or pip install ipywidgets matplotlib)")
+__all__ = ["explore", "Explorer", "MU_RANGE_FACTOR"]
 
 #: μ's slider reaches this multiple of μ_c (beyond μ_c the result is flagged).
 MU_RANGE_FACTOR = 1.5
@@ -47,7 +45,7 @@ MU_RANGE_FACTOR = 1.5
 _COEFFICIENTS = ("restitution", "impulse_ratio", "moment_restitution", "slip")
 
 
-def explore(scene: Union[Scene, Mapping, str, Path]) -> "Explorer":
+def explore(scene: Scene | Mapping | str | Path) -> Explorer:
     """Build the explorer of a forward scene (a Scene, a mapping or a file path).
 
     The returned :class:`Explorer` shows itself as the widget when it is a
@@ -69,13 +67,12 @@ class Explorer:
     ``timings`` the total of every update.
     """
 
-    def __init__(self, scene: Union[Scene, Mapping, str, Path], *, figsize=(8.5, 5.2), dpi: int = 80):
-        try:
-            import ipywidgets as widgets
-            from matplotlib.backends.backend_agg import FigureCanvasAgg
-            from matplotlib.figure import Figure
-        except ImportError:
-            raise ImportError(INSTALL_HINT) from None
+    def __init__(self, scene: Scene | Mapping | str | Path, *, figsize=(8.5, 5.2), dpi: int = 80):
+        widgets = require("ipywidgets", extra="explore", what="impactsym.explore")
+        require("matplotlib", extra="explore", what="impactsym.explore", load=False)
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
         from . import plot
 
         self._plot = plot
@@ -93,7 +90,7 @@ class Explorer:
         self.fixed_critical = preset["fixed"].get("impulse_ratio") == CRITICAL
         impact = self.scene.impact
         self.result = None
-        self.error: Optional[str] = None
+        self.error: str | None = None
         self.last_timing = (0.0, 0.0)
         self.timings: list[float] = []
         self._busy = False
@@ -224,10 +221,7 @@ class Explorer:
             slider.description = "μ (μ_c = ?)"
             self.mu_note.value = "<small>μ_c unknown for this setting</small>"
             return
-        if critical:
-            mu = mu_c
-        else:
-            mu = slider.value
+        mu = mu_c if critical else slider.value
         lo, hi = mu_range(mu_c, mu)
         _set_range(slider, lo, hi)
         if critical:

@@ -11,7 +11,6 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Union
 
 from generated.codes import STATUS_NOT_APPROACHING
 
@@ -39,7 +38,7 @@ def invert_batch(columns, model: str = "rigid"):
     return run_columns(_kernels.inverse_kernel_for(model), columns, _kernels.INVERSE_OUTPUTS)
 
 
-def invert(scene: Union[Scene, Mapping, str, Path]) -> Result:
+def invert(scene: Scene | Mapping | str | Path) -> Result:
     """Pre-impact motion of an inverse scene (vehicles give ``final_velocity``
     and ``final_yaw_rate``). The Result's vehicle velocities and yaw rates are
     the INITIAL ones; delta-V is final minus initial."""

@@ -13,12 +13,12 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Union
+from typing import Any
 
 from . import _kernels
 from .batch import run_columns
 from .codes import describe_flags, describe_status
-from .result import UNIT_LABELS, json_number, table_cell
+from .result import UNIT_LABELS, json_number, road_speed_rows, table_cell
 from .scene import Scene, SceneError, load_scene
 
 OUTPUTS = ("s1", "s2", "v1x", "v1y", "v2x", "v2y", "Pn", "Pt", "M", "M_residual",
@@ -110,6 +110,9 @@ class Reconstruction:
                 (f"velocity x {speed}", one.velocity[0], two.velocity[0]),
                 (f"velocity y {speed}", one.velocity[1], two.velocity[1]),
                 (f"|delta-V| {speed}", one.delta_v_magnitude, two.delta_v_magnitude),
+                *road_speed_rows(self.units, [("pre-impact speed", (one.speed, two.speed)),
+                                              ("|delta-V|", (one.delta_v_magnitude,
+                                                             two.delta_v_magnitude))]),
                 ("PDOF [deg, clockwise]", one.pdof_deg, two.pdof_deg),
                 ("PDOF [o'clock]", one.pdof_clock, two.pdof_clock)]
         lines = [f"reconstruction, {self.units} units", "",
@@ -129,7 +132,7 @@ class Reconstruction:
         return "\n".join(lines)
 
 
-def reconstruct(scene: Union[Scene, Mapping, str, Path]) -> Reconstruction:
+def reconstruct(scene: Scene | Mapping | str | Path) -> Reconstruction:
     """Reconstruct the pre-impact speeds of a scene whose vehicles give
     ``final_velocity``, ``final_yaw_rate``, ``heading`` (degrees) and optionally
     ``yaw_rate`` (pre-impact, default 0); ``impact`` needs only ``normal_angle``.

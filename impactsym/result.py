@@ -10,18 +10,24 @@ minus after, so a negative value means the coefficients created energy.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, Mapping
+from typing import Any
 
 from .codes import describe_flags
 from .scene import Scene, uses_yaw
 
-__all__ = ["Result", "VehicleResult", "UNIT_LABELS", "json_number", "scene_warnings", "table_cell"]
+__all__ = ["Result", "VehicleResult", "UNIT_LABELS", "ROAD_SPEED", "json_number", "road_speed_rows",
+           "scene_warnings", "table_cell"]
 
 UNIT_LABELS = {
     "SI": {"velocity": "m/s", "yaw_rate": "rad/s", "impulse": "N·s", "moment": "N·m·s", "energy": "J"},
     "US": {"velocity": "ft/s", "yaw_rate": "rad/s", "impulse": "lb·s", "moment": "ft·lb·s", "energy": "ft·lb"},
 }
+
+#: The speed unit people read in each system, and its factor from the system's
+#: speed unit (1 mph = 22/15 ft/s exactly, 1 km/h = 1/3.6 m/s).
+ROAD_SPEED = {"SI": ("km/h", 3.6), "US": ("mph", 15.0 / 22.0)}
 
 _KERNEL_SCALARS = ("Pn", "Pt", "M", "mu", "mu_c", "TL", "TLn", "TLt", "TLm")
 
@@ -85,7 +91,7 @@ class Result:
         return "solve" if self.direction == "forward" else "invert"
 
     @classmethod
-    def from_kernel(cls, scene: Scene, out: Mapping[str, Any]) -> "Result":
+    def from_kernel(cls, scene: Scene, out: Mapping[str, Any]) -> Result:
         """Combine a scene with the output of ``_kernels.solve_one`` (status 0)."""
         flags = int(out["flags"])
         return cls(
@@ -156,6 +162,10 @@ class Result:
             (f"delta-V y {speed}", one.delta_v[1], two.delta_v[1]),
             (f"|delta-V| {speed}", one.delta_v_magnitude, two.delta_v_magnitude),
         ]
+        rows += road_speed_rows(self.units, [
+            (f"{when} speed", [math.hypot(*v.velocity) for v in self.vehicles]),
+            ("|delta-V|", [v.delta_v_magnitude for v in self.vehicles])])
+        rows.append((f"{when} yaw rate [deg/s]", math.degrees(one.yaw_rate), math.degrees(two.yaw_rate)))
         return [row for row in rows if uses_yaw(self.model) or "yaw" not in row[0]]
 
     def _impact_rows(self) -> list[tuple[str, float]]:
@@ -212,6 +222,14 @@ def _vehicle_result(vehicle, out: Mapping[str, Any], number: int) -> VehicleResu
         delta_v=delta,
         delta_v_magnitude=math.hypot(*delta),
     )
+
+
+def road_speed_rows(units: str, speeds) -> list[tuple]:
+    """Table rows of speeds (``(label, [per vehicle])`` in the system's speed
+    unit, None where unknown) in the unit people read: mph (US) or km/h (SI)."""
+    label, factor = ROAD_SPEED[units]
+    return [(f"{name} [{label}]", *(None if value is None else factor * value for value in values))
+            for name, values in speeds]
 
 
 def table_cell(value: float) -> str:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Union
 
 from generated.codes import STATUS_NOT_APPROACHING
 
@@ -20,7 +19,7 @@ _HINTS = {
 }
 
 
-def solve(scene: Union[Scene, Mapping, str, Path]) -> Result:
+def solve(scene: Scene | Mapping | str | Path) -> Result:
     """Solve the impact of a scene (a :class:`Scene`, a mapping or a file path).
 
     Returns a :class:`Result` in the scene's units.  Raises :class:`SceneError`

@@ -13,13 +13,8 @@ import pytest
 from mpmath import mp
 
 import impactsym
-
-try:
-    from . import reference as R
-    from . import scenes
-except ImportError:  # tests/ is not a package: pytest puts it on sys.path
-    import reference as R
-    import scenes
+from impactsym.testing import reference as R
+from impactsym.testing import scenes
 
 TOL = 1e-12
 N_RIGID = 200
@@ -105,6 +100,7 @@ def _assert_accurate(suite, out, refs, label):
 
 # ---------------------------------------------------------------- (a) random scenes
 
+@pytest.mark.slow  # exhaustive accuracy: 50-digit references of every suite (minutes)
 @pytest.mark.parametrize("name", ["rigid", "particle", "barrier"])
 @pytest.mark.parametrize("critical", [False, True], ids=["given_mu", "critical"])
 def test_outputs_match_reference(suites, name, critical):
@@ -116,6 +112,7 @@ def test_outputs_match_reference(suites, name, critical):
     _assert_accurate(suite, out, suite.critical if critical else suite.given, label)
 
 
+@pytest.mark.slow  # exhaustive accuracy: 50-digit references of every suite (minutes)
 def test_critical_mu_equals_mu_c(suites):
     """In critical mode the reported mu is the package's own mu_c."""
     suite = suites["rigid"]
@@ -227,6 +224,7 @@ def _momentum_residuals(suite, out):
     return worst
 
 
+@pytest.mark.slow  # exhaustive accuracy: 50-digit references of every suite (minutes)
 @pytest.mark.parametrize("name", ["rigid", "particle"])
 def test_momentum_conserved(suites, name):
     """Linear and angular momentum of the package outputs are conserved to 1e-12."""
@@ -240,6 +238,7 @@ def test_momentum_conserved(suites, name):
 
 # ---------------------------------------------------------------- (d) fixed barrier
 
+@pytest.mark.slow  # exhaustive accuracy: 50-digit references of every suite (minutes)
 @pytest.mark.parametrize("critical", [False, True], ids=["given_mu", "critical"])
 def test_fixed_barrier_stays_put(suites, critical):
     """m2 = I2 = inf: V2 = v2 and W2 = w2 exactly (and the rest matches the reference)."""
@@ -253,6 +252,7 @@ def test_fixed_barrier_stays_put(suites, critical):
     _assert_accurate(suite, out, suite.critical if critical else suite.given, "barrier")
 
 
+@pytest.mark.slow  # exhaustive accuracy: 50-digit references of every suite (minutes)
 def test_moving_fixed_body_keeps_its_velocity(suites):
     """A fixed body given a velocity keeps it exactly (inverse masses are exactly 0)."""
     suite = suites["barrier"]
@@ -288,6 +288,7 @@ def _expected_flags(ref, scales, margin=1e-9):
     return must_set, must_clear
 
 
+@pytest.mark.slow  # exhaustive accuracy: 50-digit references of every suite (minutes)
 @pytest.mark.parametrize("critical", [False, True], ids=["given_mu", "critical"])
 def test_flags_match_reference(suites, critical):
     """Flags 1 and 2 agree with the reference wherever it is unambiguous; flag 4 is clear
@@ -309,6 +310,7 @@ def test_flags_match_reference(suites, critical):
     assert not problems, f"{len(problems)} rows with wrong flags: " + "; ".join(problems[:5])
 
 
+@pytest.mark.slow  # exhaustive accuracy: 50-digit references of every suite (minutes)
 def test_mu_out_of_range_flag_set(suites):
     """mu = 1.5 mu_c and mu = -0.5 mu_c (wrong sign) both set flag 4."""
     suite = suites["rigid"]

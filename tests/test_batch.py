@@ -12,7 +12,7 @@ import pytest
 
 import impactsym
 from impactsym import codes
-from tests import scenes
+from impactsym.testing import scenes
 
 ROOT = Path(__file__).resolve().parent.parent
 OUTPUTS = ("V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M",

@@ -4,6 +4,7 @@ correction, effective masses, restitution, the seed's PDOF inconsistency, the CL
 import copy
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -65,22 +66,26 @@ def test_pdof_correction_and_direction():
     assert direction == pytest.approx(-150.0, abs=1e-9)
 
 
-def test_pdof_limit_is_45_degrees():
-    impactsym.crash3(barrier_scene([0.3, 0.3], pdof=45.0))
-    with pytest.raises(SceneError, match=r"vehicles\[0\].crush.pdof: \|pdof\| = 45.5 > 45 degrees"):
-        impactsym.crash3(barrier_scene([0.3, 0.3], pdof=-45.5))
+def test_pdof_beyond_90_degrees_is_an_error():
+    """Past 45° the correction is capped (tests/test_crash3_options.py); at 90° or
+    more the force would pull the face out: an error naming the field."""
+    impactsym.crash3(barrier_scene([0.3, 0.3], pdof=89.0))
+    with pytest.raises(SceneError, match=r"vehicles\[0\].crush.pdof: \|pdof\| = 90.5 must be < 90"):
+        impactsym.crash3(barrier_scene([0.3, 0.3], pdof=-90.5))
 
 
 @pytest.mark.parametrize(("change", "text"), [
     ({"depths": [0.1, 0.2, 0.3]}, "depths: must be a list of 2, 4 or 6 crush depths"),
-    ({"depths": [0.1, -0.2]}, "crush: a CRASH3 crush input is out of range"),
-    ({"B": 0.0}, "crush: a CRASH3 crush input is out of range"),
+    ({"depths": [0.1, -0.2]}, "crush.depths[1]: must be >= 0 (a crush depth), got -0.2"),
+    ({"B": 0.0}, "crush.B: must be > 0 (the slope of force per unit width against crush), got 0"),
+    ({"A": -1.0}, "crush.A: must be >= 0"),
+    ({"width": 0.0}, "crush.width: must be > 0 (the damage width)"),
     ({"A": "stiff"}, "crush.A: must be a finite number"),
 ])
 def test_bad_crush_tables_name_their_field(change, text):
     data = barrier_scene([0.3, 0.3])
     data["vehicles"][0]["crush"].update(change)
-    with pytest.raises(SceneError, match=text.replace("[", r"\[").replace("(", r"\(")):
+    with pytest.raises(SceneError, match=re.escape(text)):
         impactsym.crash3(data)
 
 
@@ -208,7 +213,7 @@ def test_cli_crash3_json_and_table(capsys):
 
 def test_cli_crash3_bad_scene_is_one_line(capsys, tmp_path):
     data = copy.deepcopy(TWO_CAR)
-    data["vehicles"][0]["crush"]["pdof"] = 60
+    data["vehicles"][0]["crush"]["pdof"] = 95
     path = tmp_path / "bad.json"
     path.write_text(json.dumps(data))
     assert main(["crash3", str(path)]) == 2

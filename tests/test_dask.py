@@ -15,7 +15,7 @@ import pandas as pd
 import pytest
 
 import impactsym
-from impactsym import dask_engine
+from impactsym import batch, dask_engine
 
 distributed = pytest.importorskip("distributed")
 
@@ -48,12 +48,14 @@ def client():
         yield c
 
 
+@pytest.mark.slow  # a two-process LocalCluster whose workers each load the kernels
 def test_sweep_on_the_cluster_equals_local(client):
     local = impactsym.sweep(US, **GRID)
     assert (local["status"] != 0).any() and (local["mu"] == "critical").any()
     assert_same(impactsym.sweep(US, **GRID, chunk_size=7, engine="dask"), local)
 
 
+@pytest.mark.slow  # a two-process LocalCluster whose workers each load the kernels
 def test_sample_on_the_cluster_equals_local_whatever_the_chunks(client):
     n = importlib.import_module("impactsym.sweep").BLOCK + 500
     local = impactsym.sample(SI, DISTS, n, seed=21, chunk_size=5000)
@@ -63,6 +65,7 @@ def test_sample_on_the_cluster_equals_local_whatever_the_chunks(client):
     assert dask.attrs["seed"] == 21
 
 
+@pytest.mark.slow  # a two-process LocalCluster whose workers each load the kernels
 def test_streaming_on_the_cluster_writes_the_local_rows_in_order(client, tmp_path):
     local = impactsym.sweep(US, **GRID)
     summary = impactsym.sweep(US, **GRID, chunk_size=5, engine="dask", out=tmp_path / "g.csv")
@@ -86,11 +89,12 @@ def _columns(n: int) -> dict:
     return columns
 
 
+@pytest.mark.slow  # a two-process LocalCluster whose workers each load the kernels
 def test_solve_batch_on_the_cluster_equals_local(client):
     columns = _columns(1000)
     local = impactsym.solve_batch(columns)
     via_engine = impactsym.solve_batch(columns, engine="dask")
-    chunked = dask_engine.solve_batch_dask(columns, chunk_size=130)
+    chunked = batch.solve_batch_dask(columns, chunk_size=130)
     for result in (via_engine, chunked):
         assert list(result) == list(local)
         for name, column in local.items():
@@ -99,18 +103,19 @@ def test_solve_batch_on_the_cluster_equals_local(client):
     assert local["status"][7] != 0
 
 
+@pytest.mark.slow  # a two-process LocalCluster whose workers each load the kernels
 def test_solve_batch_of_a_dataframe_keeps_its_index(client):
     columns = _columns(300)
     frame = pd.DataFrame({k: np.broadcast_to(v, (300,)) for k, v in columns.items()},
                          index=pd.Index(np.arange(300) * 3 + 1000, name="case"))
     local = impactsym.solve_batch(frame, outputs="impulses")
-    assert_same(dask_engine.solve_batch_dask(frame, outputs="impulses", chunk_size=64), local)
+    assert_same(batch.solve_batch_dask(frame, outputs="impulses", chunk_size=64), local)
     assert_same(impactsym.solve_batch(frame, outputs="impulses", engine="dask"), local)
 
 
 def test_solve_batch_with_unequal_columns_raises_one_line():
     with pytest.raises(ValueError, match=r"^e: length 3 differs from the other columns \(2\)$"):
-        dask_engine.solve_batch_dask({"m1": np.ones(2), "e": np.ones(3)})
+        batch.solve_batch_dask({"m1": np.ones(2), "e": np.ones(3)})
 
 
 def test_without_dask_the_error_names_the_extra(monkeypatch):

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import impactsym
-from tests import scenes
+from impactsym.testing import scenes
 
 
 def _approach_ratio(c):

@@ -21,6 +21,7 @@ def _run_derive(*args, cwd=ROOT):
                           capture_output=True, text=True, timeout=300)
 
 
+@pytest.mark.slow  # SymPy proves every claim: minutes
 @pytest.mark.parametrize("module", [particle, planar, delta_v, inverse, reconstruct, presets, crash3,
                                     report], ids=lambda m: m.__name__)
 def test_every_proof_passes(module):
@@ -28,6 +29,7 @@ def test_every_proof_passes(module):
     assert not failed, f"failed proofs: {failed}"
 
 
+@pytest.mark.slow  # SymPy re-proves the planar model
 def test_a_wrong_formula_fails_its_proof(monkeypatch):
     """The proofs are not vacuous: perturb the restitution formula and they fail."""
     good = planar._impulse_blocks
@@ -45,6 +47,7 @@ def test_a_wrong_formula_fails_its_proof(monkeypatch):
     assert not results["rigid: the closed forms satisfy the six equations"]
 
 
+@pytest.mark.slow  # python -m derive proves and renders everything: minutes
 def test_regenerating_into_a_temporary_folder_gives_identical_bytes(tmp_path):
     proc = _run_derive("--out", str(tmp_path))
     assert proc.returncode == 0, proc.stdout + proc.stderr
@@ -52,11 +55,13 @@ def test_regenerating_into_a_temporary_folder_gives_identical_bytes(tmp_path):
         assert (tmp_path / name).read_bytes() == (ROOT / "generated" / name).read_bytes(), name
 
 
+@pytest.mark.slow  # python -m derive proves and renders everything: minutes
 def test_check_passes_on_the_committed_files():
     proc = _run_derive("--check")
     assert proc.returncode == 0, proc.stdout + proc.stderr
 
 
+@pytest.mark.slow  # python -m derive proves and renders everything: minutes
 def test_check_fails_when_a_generated_file_was_edited(tmp_path):
     for name, text in derive_main.render_all().items():
         (tmp_path / name).write_text(text)

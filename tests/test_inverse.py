@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import impactsym
 from impactsym.cli import main
-from tests import scenes
+from impactsym.testing import scenes
 
 FWD_IN = ("v1x", "v1y", "w1", "v2x", "v2y", "w2")
 FWD_OUT = ("V1x", "V1y", "W1", "V2x", "V2y", "W2")
@@ -102,7 +103,7 @@ def test_cli_invert_prints_the_documented_object(capsys):
 
 
 def test_cli_invert_with_zero_restitution_exits_2_naming_what_is_missing(tmp_path, capsys):
-    scene = json.loads(open("examples/invert_two_car_si.json").read())
+    scene = json.loads(Path("examples/invert_two_car_si.json").read_text())
     scene["impact"]["restitution"] = 0.0
     path = tmp_path / "e0.json"
     path.write_text(json.dumps(scene))
@@ -112,7 +113,7 @@ def test_cli_invert_with_zero_restitution_exits_2_naming_what_is_missing(tmp_pat
 
 
 def test_cli_invert_refuses_a_critical_impulse_ratio(tmp_path, capsys):
-    scene = json.loads(open("examples/invert_two_car_si.json").read())
+    scene = json.loads(Path("examples/invert_two_car_si.json").read_text())
     scene["impact"]["impulse_ratio"] = "critical"
     path = tmp_path / "crit.json"
     path.write_text(json.dumps(scene))

@@ -11,11 +11,10 @@ import pytest
 
 import impactsym
 from derive import presets as derive_presets
+from generated.presets import PRESETS
 from impactsym.cli import main
 from impactsym.scene import SceneError, load_scene
-from generated.presets import PRESETS
-
-from .scenes import random_realistic
+from impactsym.testing.scenes import random_realistic
 
 ROOT = Path(__file__).resolve().parents[1]
 TWO_CAR = json.loads((ROOT / "examples" / "two_car_us.json").read_text())

@@ -20,6 +20,9 @@ REPO_ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = sorted((REPO_ROOT / "notebooks").glob("*.ipynb"))
 CELL_TIMEOUT = 300  # seconds, per cell
 
+# Minutes: each notebook runs in a fresh kernel (the full suite runs them; the fast loop does not).
+pytestmark = pytest.mark.slow
+
 ENVIRONMENT_CHECK = (
     "import sys as _sys\n"
     f"assert _sys.prefix == {sys.prefix!r}, "

@@ -15,7 +15,7 @@ import pandas as pd
 import pytest
 
 import impactsym
-from impactsym import plot
+from impactsym import plot, plot_sweep
 
 matplotlib.use("Agg")
 SCENE = Path(__file__).resolve().parent.parent / "examples" / "intersection_si.toml"
@@ -82,7 +82,7 @@ def test_impossible_mask_covers_exactly_the_flagged_cells(e_mu):
     assert flagged.any() and not flagged.all()
     assert (_grid_of(e_mu, "mu", "e", "mu") < _grid_of(e_mu, "mu_c", "e", "mu"))[flagged].any()  # beyond μ_c
     shuffled = e_mu.sample(frac=1.0, random_state=1)  # row order does not matter
-    ax = plot.sweep(shuffled, "e", "mu", ax=_axes(), units="SI")
+    ax = plot_sweep.sweep(shuffled, "e", "mu", ax=_axes(), units="SI")
     (mask,) = _by_gid(ax, "impossible")
     np.testing.assert_array_equal(_covered(mask, E, MU), flagged)
     assert not _by_gid(ax, "not_solved")  # every row solved
@@ -90,8 +90,8 @@ def test_impossible_mask_covers_exactly_the_flagged_cells(e_mu):
     values = mesh.get_array()
     np.testing.assert_array_equal(np.ma.getmaskarray(values).reshape(flagged.shape), flagged)
     np.testing.assert_allclose(values.compressed(), _grid_of(e_mu, "TL", "e", "mu")[~flagged])
-    assert plot.IMPOSSIBLE_LABEL in _legend_texts(ax)
-    transposed = plot.sweep(shuffled, "mu", "e", ax=_axes())  # two flagged runs along each row
+    assert plot_sweep.IMPOSSIBLE_LABEL in _legend_texts(ax)
+    transposed = plot_sweep.sweep(shuffled, "mu", "e", ax=_axes())  # two flagged runs along each row
     (mask,) = _by_gid(transposed, "impossible")
     np.testing.assert_array_equal(_covered(mask, MU, E), flagged.T)
 
@@ -100,18 +100,18 @@ def test_not_solved_cells_have_their_own_mask():
     df = _frame(normal_angle=np.linspace(-30.0, 80.0, 12), mu=np.linspace(-0.8, 0.6, 8))
     unsolved = _grid_of(df, "status", "normal_angle", "mu") != 0
     assert unsolved.any() and not unsolved.all()  # a steep normal: not approaching
-    ax = plot.sweep(df, "normal_angle", "mu", ax=_axes())
+    ax = plot_sweep.sweep(df, "normal_angle", "mu", ax=_axes())
     xs, ys = np.unique(df["normal_angle"]), np.unique(df["mu"])
     (mask,) = _by_gid(ax, "not_solved")
     np.testing.assert_array_equal(_covered(mask, xs, ys), unsolved)
     (impossible,) = _by_gid(ax, "impossible")
     assert not (_covered(impossible, xs, ys) & unsolved).any()
-    assert plot.NOT_SOLVED_LABEL in _legend_texts(ax)
+    assert plot_sweep.NOT_SOLVED_LABEL in _legend_texts(ax)
     assert ax.get_xlabel() == "normal angle Γ [°]"
 
 
 def test_cell_edges_are_halfway_between_non_uniform_values(e_mu):
-    ax = plot.sweep(e_mu, "e", "mu", ax=_axes())
+    ax = plot_sweep.sweep(e_mu, "e", "mu", ax=_axes())
     (mesh,) = _by_gid(ax, "values")
     xedges = mesh.get_coordinates()[0, :, 0]
     np.testing.assert_allclose(xedges, [-0.025, 0.025, 0.075, 0.15, 0.3, 0.55, 0.85, 1.15])
@@ -119,7 +119,7 @@ def test_cell_edges_are_halfway_between_non_uniform_values(e_mu):
 
 
 def test_a_single_value_along_an_axis_gets_a_cell(e_mu):
-    ax = plot.sweep(e_mu[e_mu.e == 0.4], "e", "mu", color="dV1", ax=_axes())
+    ax = plot_sweep.sweep(e_mu[e_mu.e == 0.4], "e", "mu", color="dV1", ax=_axes())
     (mesh,) = _by_gid(ax, "values")
     np.testing.assert_allclose(mesh.get_coordinates()[0, :, 0], [0.36, 0.44])
     (line,) = _by_gid(ax, "mu_c")  # spans the single cell
@@ -129,12 +129,12 @@ def test_a_single_value_along_an_axis_gets_a_cell(e_mu):
 def test_mu_c_line_follows_mu_c_against_the_other_axis(e_mu):
     mu_c = e_mu.groupby("e")["mu_c"].first().to_numpy()
     assert np.ptp(mu_c) > 0.05  # μ_c varies with e
-    ax = plot.sweep(e_mu, "e", "mu", ax=_axes())
+    ax = plot_sweep.sweep(e_mu, "e", "mu", ax=_axes())
     (line,) = _by_gid(ax, "mu_c")
     np.testing.assert_allclose(line.get_xdata(), E)
     np.testing.assert_allclose(line.get_ydata(), mu_c)
     assert "μ = μ_c" in _legend_texts(ax)
-    transposed = plot.sweep(e_mu, "mu", "e", ax=_axes())
+    transposed = plot_sweep.sweep(e_mu, "mu", "e", ax=_axes())
     (line,) = _by_gid(transposed, "mu_c")
     np.testing.assert_allclose(line.get_xdata(), mu_c)
     np.testing.assert_allclose(line.get_ydata(), E)
@@ -142,18 +142,18 @@ def test_mu_c_line_follows_mu_c_against_the_other_axis(e_mu):
 
 def test_no_mu_c_line_without_mu_on_an_axis():
     df = _frame(e=E, normal_angle=np.array([0.0, 10.0, 20.0]))
-    ax = plot.sweep(df, "e", "normal_angle", ax=_axes())
+    ax = plot_sweep.sweep(df, "e", "normal_angle", ax=_axes())
     assert not _by_gid(ax, "mu_c")
-    assert "mu" in df and plot.MU_C_LABEL not in [line.get_label() for line in ax.lines]
+    assert "mu" in df and plot_sweep.MU_C_LABEL not in [line.get_label() for line in ax.lines]
 
 
 def test_colourbar_label_carries_the_quantity_and_units(e_mu):
     labels = {}
     for units in ("SI", "US", None):
-        ax = plot.sweep(e_mu, "e", "mu", color="dV1", ax=_axes(), units=units)
+        ax = plot_sweep.sweep(e_mu, "e", "mu", color="dV1", ax=_axes(), units=units)
         labels[units] = [other.get_ylabel() for other in ax.figure.axes if other is not ax][0]
     assert labels == {"SI": "delta-V dV1 [m/s]", "US": "delta-V dV1 [ft/s]", None: "delta-V dV1"}
-    ax = plot.sweep(e_mu, "e", "mu", ax=_axes(), units="US")
+    ax = plot_sweep.sweep(e_mu, "e", "mu", ax=_axes(), units="US")
     assert [other.get_ylabel() for other in ax.figure.axes if other is not ax] == ["energy loss TL [ft·lb]"]
 
 
@@ -162,7 +162,7 @@ def test_colourbar_label_carries_the_quantity_and_units(e_mu):
 
 def test_line_plot_marks_the_impossible_points(e_mu):
     one = e_mu[e_mu.e == 0.2].sample(frac=1.0, random_state=2)
-    ax = plot.sweep(one, "mu", ax=_axes(), units="SI")
+    ax = plot_sweep.sweep(one, "mu", ax=_axes(), units="SI")
     (line,) = _by_gid(ax, "values")
     ordered = one.sort_values("mu")
     np.testing.assert_allclose(line.get_xdata(), ordered["mu"])
@@ -173,12 +173,12 @@ def test_line_plot_marks_the_impossible_points(e_mu):
     np.testing.assert_allclose(crosses.get_xdata(), ordered["mu"][flagged])
     (mu_c,) = _by_gid(ax, "mu_c")
     assert mu_c.get_xdata()[0] == pytest.approx(one["mu_c"].iloc[0])
-    assert plot.IMPOSSIBLE_LABEL in _legend_texts(ax) and ax.get_ylabel() == "energy loss TL [J]"
+    assert plot_sweep.IMPOSSIBLE_LABEL in _legend_texts(ax) and ax.get_ylabel() == "energy loss TL [J]"
 
 
 def test_line_plot_of_several_columns(e_mu):
     one = e_mu[e_mu.mu == MU[5]]
-    ax = plot.sweep(one, "e", color=["dV1", "dV2"], ax=_axes(), units="SI")
+    ax = plot_sweep.sweep(one, "e", color=["dV1", "dV2"], ax=_axes(), units="SI")
     lines = _by_gid(ax, "values")
     assert [line.get_label() for line in lines] == ["delta-V dV1 [m/s]", "delta-V dV2 [m/s]"]
     np.testing.assert_allclose(lines[1].get_ydata(), one.sort_values("e")["dV2"])
@@ -193,29 +193,29 @@ def test_line_plot_of_several_columns(e_mu):
                                         (("e", "mu", "energy"), "energy")])
 def test_unknown_column_is_named(e_mu, args, name):
     with pytest.raises(ValueError, match=f"^{name}: no such column"):
-        plot.sweep(e_mu, *args, ax=_axes())
+        plot_sweep.sweep(e_mu, *args, ax=_axes())
 
 
 def test_a_varied_column_the_axes_do_not_use_asks_to_filter(e_mu):
     with pytest.raises(ValueError, match="varies mu.*filter") as error:
-        plot.sweep(e_mu, "e", ax=_axes())
+        plot_sweep.sweep(e_mu, "e", ax=_axes())
     assert "\n" not in str(error.value)
     three = _frame(e=E[:3], mu=MU[:3], m1=np.array([1200.0, 1500.0]))
     with pytest.raises(ValueError, match="varies m1"):
-        plot.sweep(three, "e", "mu", ax=_axes())
-    plot.sweep(three[three.m1 == 1500.0], "e", "mu", ax=_axes())  # filtered: fine
+        plot_sweep.sweep(three, "e", "mu", ax=_axes())
+    plot_sweep.sweep(three[three.m1 == 1500.0], "e", "mu", ax=_axes())  # filtered: fine
 
 
 def test_rows_that_do_not_form_a_full_grid(e_mu):
     with pytest.raises(ValueError, match="not a full grid"):
-        plot.sweep(e_mu.iloc[1:], "e", "mu", ax=_axes())
+        plot_sweep.sweep(e_mu.iloc[1:], "e", "mu", ax=_axes())
 
 
 def test_bad_units_and_a_list_colour_on_a_heatmap(e_mu):
     with pytest.raises(ValueError, match="units"):
-        plot.sweep(e_mu, "e", "mu", ax=_axes(), units="metric")
+        plot_sweep.sweep(e_mu, "e", "mu", ax=_axes(), units="metric")
     with pytest.raises(ValueError, match="heatmap shows one column"):
-        plot.sweep(e_mu, "e", "mu", color=["dV1", "dV2"], ax=_axes())
+        plot_sweep.sweep(e_mu, "e", "mu", color=["dV1", "dV2"], ax=_axes())
 
 
 # --------------------------------------------------------------------------- file
@@ -227,8 +227,12 @@ def test_save_sweep_writes_a_png_without_pyplot_figures(e_mu, tmp_path):
     before = plt.get_fignums()
     for y in ("mu", None):
         frame = e_mu if y else e_mu[e_mu.e == 0.4]
-        path = plot.save_sweep(frame, tmp_path / f"sweep_{y}.png", "e" if y else "mu", y, units="SI")
+        path = plot_sweep.save_sweep(frame, tmp_path / f"sweep_{y}.png", "e" if y else "mu", y, units="SI")
         data = Path(path).read_bytes()
         assert data[:8] == b"\x89PNG\r\n\x1a\n"
         assert len(data) > MIN_PNG_BYTES, len(data)
     assert plt.get_fignums() == before
+
+
+def test_the_sweep_plots_are_also_impactsym_plot_names():
+    assert plot.sweep is plot_sweep.sweep and plot.save_sweep is plot_sweep.save_sweep

@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import impactsym
 from impactsym.cli import main
-from tests import scenes
+from impactsym.testing import scenes
 
 
 def _forward_then_columns(n=300, seed=21):
@@ -70,7 +71,7 @@ def test_cli_reconstruct_prints_the_documented_object(capsys):
 
 
 def test_a_fixed_vehicle_cannot_be_reconstructed(tmp_path, capsys):
-    scene = json.loads(open("examples/reconstruct_two_car_si.json").read())
+    scene = json.loads(Path("examples/reconstruct_two_car_si.json").read_text())
     scene["vehicles"][1] = {"name": "wall", "fixed": True}
     path = tmp_path / "wall.json"
     path.write_text(json.dumps(scene))

@@ -13,12 +13,8 @@ import numpy as np
 import pytest
 from mpmath import mp
 
-try:
-    from . import reference as R
-    from . import scenes
-except ImportError:  # tests/ is not a package: pytest puts it on sys.path
-    import reference as R
-    import scenes
+from impactsym.testing import reference as R
+from impactsym.testing import scenes
 
 TIGHT = mp.mpf("1e-40")
 
@@ -91,7 +87,7 @@ def _momenta(row, ref, origin):
 def _relative_contact(row, ref, gamma):
     """(n, t) components of u2 - u1 (ref None) or U2 - U1, computed from scratch."""
     comps = []
-    for m, I, vx, vy, w, rx, ry in _velocity_state(row, ref):
+    for _m, _I, vx, vy, w, rx, ry in _velocity_state(row, ref):
         comps.append((vx - w * ry, vy + w * rx))
     dx, dy = comps[1][0] - comps[0][0], comps[1][1] - comps[0][1]
     c, s = mp.cos(gamma), mp.sin(gamma)
@@ -101,7 +97,7 @@ def _relative_contact(row, ref, gamma):
 def _kinetic(row, ref):
     """Total kinetic energy of the non-fixed bodies, initial (ref None) or final."""
     T = mp.zero
-    for m, I, vx, vy, w, rx, ry in _velocity_state(row, ref):
+    for m, I, vx, vy, w, _rx, _ry in _velocity_state(row, ref):
         if mp.isfinite(m):
             T += m * (vx ** 2 + vy ** 2) / 2
         if mp.isfinite(I):

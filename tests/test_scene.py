@@ -71,7 +71,7 @@ BAD_VALUES = [
     (("vehicles", 0, "mass"), math.nan, "vehicles[0].mass", "positive finite"),
     (("vehicles", 0, "mass"), math.inf, "vehicles[0].mass", "positive finite"),
     (("vehicles", 0, "mass"), True, "vehicles[0].mass", "positive finite"),
-    (("vehicles", 0, "mass"), "100", "vehicles[0].mass", "positive finite"),
+    (("vehicles", 0, "mass"), "100", "vehicles[0].mass", "needs a mass (kg, lb, slug)"),
     (("vehicles", 0, "mass"), MISSING, "vehicles[0].mass", "missing"),
     (("vehicles", 1, "yaw_inertia"), -1.0, "vehicles[1].yaw_inertia", "positive finite"),
     (("vehicles", 1, "yaw_inertia"), MISSING, "vehicles[1].yaw_inertia", "missing"),
@@ -79,8 +79,8 @@ BAD_VALUES = [
     (("vehicles", 0, "impact_point"), [1.0, 2.0, 3.0], "vehicles[0].impact_point", "list of 2"),
     (("vehicles", 0, "velocity"), [50.0], "vehicles[0].velocity", "list of 2 numbers"),
     (("vehicles", 0, "velocity"), "fast", "vehicles[0].velocity", "list of 2 numbers"),
-    (("vehicles", 0, "velocity"), [50.0, math.nan], "vehicles[0].velocity", "finite"),
-    (("vehicles", 0, "velocity"), [50.0, False], "vehicles[0].velocity", "finite"),
+    (("vehicles", 0, "velocity"), [50.0, math.nan], "vehicles[0].velocity[1]", "finite"),
+    (("vehicles", 0, "velocity"), [50.0, False], "vehicles[0].velocity[1]", "finite"),
     (("vehicles", 0, "velocity"), MISSING, "vehicles[0].velocity", "missing"),
     (("vehicles", 0, "yaw_rate"), math.inf, "vehicles[0].yaw_rate", "finite"),
     (("vehicles", 0, "fixed"), "yes", "vehicles[0].fixed", "true or false"),
@@ -209,7 +209,10 @@ def test_inputs_of_the_conventions_scene():
 
 @pytest.mark.parametrize(("degrees", "radians"), [(30.0, math.pi / 6), (-90, -math.pi / 2), (180.0, math.pi)])
 def test_normal_angle_degrees_become_radians(degrees, radians):
-    scene = load_scene(scene_with(("impact", "normal_angle"), degrees))
+    # particles: no impact points, so the normal's sense is kept as given
+    data = scene_with(("impact", "normal_angle"), degrees)
+    data["model"] = "particle"
+    scene = load_scene(data)
     assert scene.impact.normal_angle == degrees
     assert scene.to_inputs()[2]["gamma"] == pytest.approx(radians, rel=1e-15, abs=1e-15)
 
@@ -276,19 +279,34 @@ def test_integer_values_are_accepted_as_floats():
     assert scene.to_inputs()[2]["m1"] == 100.0
 
 
-def test_documented_extras_are_kept_and_unknown_keys_warned():
+def test_documented_extras_are_kept_and_unused_keys_reported():
     data = copy.deepcopy(BASE)
     data["description"] = "a test"
-    data["vehicles"][0].update(heading=0.0, final_velocity=[20, 5], crush={"A": 1.0}, yaw_rat=0.5)
-    data["impact"]["restitusion"] = 0.2
+    data["vehicles"][0].update(heading=0.0, final_velocity=[20, 5], crush={"A": 1.0})
     scene = load_scene(data)
     extra = scene.vehicles[0].extra
     assert extra["heading"] == 0.0 and extra["final_velocity"] == (20.0, 5.0) and extra["crush"] == {"A": 1.0}
     assert scene.extra == {"description": "a test"}
-    assert scene.warnings == (
-        "ignored unknown key impact.restitusion",
-        "ignored unknown key vehicles[0].yaw_rat",
-    )
+    assert [w.split(" is given")[0] for w in scene.warnings] == [
+        "vehicles[0].final_velocity", "vehicles[0].crush"]
+
+
+@pytest.mark.parametrize(("where", "key", "suggestion"), [
+    (("impact",), "restitusion", "restitution"),
+    (("vehicles", 0), "yaw_rat", "yaw_rate"),
+    ((), "unit", "units"),
+    (("impact",), "moment_restitutoin", "moment_restitution"),
+])
+def test_unknown_key_is_an_error_with_a_suggestion(where, key, suggestion):
+    data = copy.deepcopy(BASE)
+    target = data
+    for step in where:
+        target = target[step]
+    target[key] = 0.5
+    path = ".".join(f"[{s}]" if isinstance(s, int) else s for s in (*where, key)).replace(".[", "[")
+    with pytest.raises(SceneError) as info:
+        load_scene(data)
+    assert str(info.value) == f'{path}: unknown key; did you mean "{suggestion}"?'
 
 
 def test_load_scene_accepts_a_scene_and_revalidates_it():

@@ -15,13 +15,8 @@ import pytest
 
 import impactsym
 from impactsym import _kernels
-
-try:
-    from . import reference as R
-    from . import scenes
-except ImportError:  # tests/ is not a package: pytest puts it on sys.path
-    import reference as R
-    import scenes
+from impactsym.testing import reference as R
+from impactsym.testing import scenes
 
 TIERS = ("velocities", "impulses", "energy")
 N = 150

@@ -36,13 +36,11 @@ from hypothesis.extra import numpy as hnp
 from mpmath import mp
 
 import impactsym
+from impactsym.testing import reference as R
+from impactsym.testing import scenes
 
-try:
-    from . import reference as R
-    from . import scenes
-except ImportError:  # tests/ is not a package: pytest puts it on sys.path
-    import reference as R
-    import scenes
+# Minutes: thousands of hard rows checked against the 50-digit reference.
+pytestmark = pytest.mark.slow
 
 TOL = 1e-12
 """Largest accepted error of every output, relative to its natural scale."""
@@ -216,7 +214,7 @@ def _check(columns, model, critical, label, *, flags=True, out=None):
                                 f"{mp.nstr(ref['Pn'], 6)}, mu {mp.nstr(ref['mu'], 8)}, "
                                 f"mu_c {mp.nstr(ref['mu_c'], 8)})")
     record = WORST.setdefault(label, {})
-    for key, (err, i) in worst.items():
+    for key, (err, _i) in worst.items():
         if key not in record or not err <= record[key]:
             record[key] = err
     assert not problems, (f"{label}: {len(problems)} problems in {n} rows; first: "

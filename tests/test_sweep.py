@@ -19,6 +19,7 @@ import impactsym
 from impactsym.cli import main
 
 sweeps = importlib.import_module("impactsym.sweep")  # impactsym.sweep is the function
+quantiles = importlib.import_module("impactsym._quantiles")
 
 ROOT = Path(__file__).resolve().parents[1]
 US = ROOT / "examples" / "two_car_us.json"          # rigid, mu = 0.3
@@ -317,24 +318,24 @@ def test_percentiles_of_no_solved_row_are_nan():
 
 def test_order_statistics_select_exactly_through_radix_passes(tmp_path, monkeypatch):
     """Small budgets force every 16-bit pass, and groups of equal keys."""
-    monkeypatch.setattr(sweeps._OrderStatistics, "SORT_BUDGET", 64)
-    monkeypatch.setattr(sweeps._OrderStatistics, "READ_BLOCK", 1000)
+    monkeypatch.setattr(quantiles.OrderStatistics, "SORT_BUDGET", 64)
+    monkeypatch.setattr(quantiles.OrderStatistics, "READ_BLOCK", 1000)
     rng = np.random.default_rng(0)
     values = np.concatenate([rng.normal(0, 1e3, 4000), np.full(700, 2.5), -np.logspace(-300, 300, 500),
                              np.zeros(300), rng.uniform(-1, 1, 3000) * 1e-6])
     rng.shuffle(values)
-    stats = sweeps._OrderStatistics(tmp_path / "values.f8")
+    stats = quantiles.OrderStatistics(tmp_path / "values.f8")
     for part in np.array_split(values, 7):
         stats.add(part)
     ranks = [0, 1, 2500, 4321, 4999, 5000, 6000, values.size - 1]
     found = stats.select(ranks)
     np.testing.assert_array_equal([found[r] for r in ranks], np.sort(values)[ranks])
-    summary = sweeps._interpolate(stats, (0, 5, 33.3, 50, 97.5, 100))
+    summary = quantiles._interpolate(stats, (0, 5, 33.3, 50, 97.5, 100))
     np.testing.assert_array_equal(summary, np.percentile(values, [0, 5, 33.3, 50, 97.5, 100]))
 
 
 def test_streamed_summary_equals_the_in_memory_one(tmp_path, monkeypatch):
-    monkeypatch.setattr(sweeps._OrderStatistics, "SORT_BUDGET", 100)
+    monkeypatch.setattr(quantiles.OrderStatistics, "SORT_BUDGET", 100)
     df = impactsym.sample(US, DISTS, 3000, seed=9)
     streamed = impactsym.sample(US, DISTS, 3000, seed=9, chunk_size=700, out=tmp_path / "s.parquet")
     assert_same(streamed, impactsym.percentiles(df))

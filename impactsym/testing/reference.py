@@ -1,11 +1,13 @@
 """Independent 50-digit reference solver for the planar impact equations.
 
-This module shares no algebra with the package's closed forms: it writes the six
-equations of ``/work/shared/conventions.md`` as one linear system in the unknowns
+Test support, not runtime code: ``import impactsym`` never imports it, it needs
+mpmath (the ``test`` extra), and it never imports ``derive`` or ``generated``.
+It shares no algebra with the package's closed forms: it writes the six
+impact equations (the frame and signs below) as one linear system in the unknowns
 ``(V1x, V1y, W1, V2x, V2y, W2, Px, Py, M)`` and solves it numerically with
 ``mpmath.lu_solve`` at 50 significant digits.
 
-Conventions (the contract in conventions.md):
+Conventions:
 
 * scene frame (x, y); ``n = (cos gamma, sin gamma)`` points from vehicle 1 toward
   vehicle 2, ``t = (-sin gamma, cos gamma)``; the vehicles approach when
@@ -35,10 +37,9 @@ from mpmath import mp
 DPS = 50
 """Working precision of the reference, in decimal digits."""
 
-RIGID_INPUTS = ("m1 m2 I1 I2 v1x v1y w1 v2x v2y w2 "
-                "r1x r1y r2x r2y gamma e mu e_m").split()
-PARTICLE_INPUTS = "m1 m2 v1x v1y v2x v2y gamma e mu".split()
-OUTPUTS = "V1x V1y W1 V2x V2y W2 Pn Pt M mu mu_c TL TLn TLt TLm".split()
+RIGID_INPUTS = ["m1", "m2", "I1", "I2", "v1x", "v1y", "w1", "v2x", "v2y", "w2", "r1x", "r1y", "r2x", "r2y", "gamma", "e", "mu", "e_m"]
+PARTICLE_INPUTS = ["m1", "m2", "v1x", "v1y", "v2x", "v2y", "gamma", "e", "mu"]
+OUTPUTS = ["V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M", "mu", "mu_c", "TL", "TLn", "TLt", "TLm"]
 VELOCITY_KEYS = ("V1x", "V1y", "V2x", "V2y")
 YAW_KEYS = ("W1", "W2")
 ENERGY_KEYS = ("TL", "TLn", "TLt", "TLm")

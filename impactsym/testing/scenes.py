@@ -1,4 +1,7 @@
-"""Scene generators for the accuracy tests.
+"""Scene generators for the accuracy tests, the benchmarks and the notebooks.
+
+Test support, not runtime code (``import impactsym`` never imports it); it never
+imports ``derive`` or ``generated``.
 
 Every generator returns *columns*: a dict mapping the batch input names of
 conventions.md (``m1 m2 I1 I2 v1x v1y w1 v2x v2y w2 r1x r1y r2x r2y gamma e mu e_m``;
@@ -10,10 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-try:  # imported as tests.scenes or, with tests/ on sys.path, as scenes
-    from . import reference
-except ImportError:  # pragma: no cover
-    import reference
+from . import reference
 
 RIGID = reference.RIGID_INPUTS
 PARTICLE = reference.PARTICLE_INPUTS

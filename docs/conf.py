@@ -1,0 +1,86 @@
+"""Sphinx configuration of the impactsym documentation.
+
+Build (from the repository root; no network, notebooks are not executed):
+
+    python -m sphinx -W --keep-going -b html docs docs/_build/html
+
+Pages are Markdown (MyST). Notebooks are rendered by myst-nb from the outputs
+stored in them, never executed here: tests/test_notebooks.py executes them.
+Topic pages dropped into docs/ (docs/<topic>.md) join the user guide through
+the glob in index.md without an edit here.
+"""
+
+import re
+import sys
+from pathlib import Path
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:
+    import tomli as tomllib
+
+ROOT = Path(__file__).resolve().parents[1]
+# autodoc imports the package from this checkout, never from an installed copy.
+sys.path.insert(0, str(ROOT))
+
+project = "impactsym"
+author = "impactsym contributors"
+release = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]["version"]
+version = release
+
+extensions = [
+    "myst_nb",  # Markdown pages (MyST) and notebooks
+    "sphinx.ext.autodoc",
+    "numpydoc",  # plain docstrings render as written; numpy sections if one has them
+    "sphinx.ext.mathjax",
+]
+
+exclude_patterns = ["_build", "Thumbs.db", ".DS_Store", "**.ipynb_checkpoints"]
+
+# MyST: $...$ and $$...$$ math, ::: fences for admonitions, anchors for
+# headings (links to #sections).
+myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence"]
+myst_heading_anchors = 3
+# A heading that skips a level (## then ####) renders fine; it is style, not an error.
+suppress_warnings = ["myst.header"]
+
+# Notebooks: render the stored outputs; never run a kernel at build time.
+nb_execution_mode = "off"
+
+# Docstrings: `name` in a docstring is code, as it reads in the source.
+default_role = "code"
+autodoc_member_order = "bysource"
+autodoc_typehints = "signature"
+# Reading docstrings needs no compiler: numba is replaced by a stand-in while
+# autodoc imports the package (kernels are never called at build time).
+autodoc_mock_imports = ["numba"]
+autodoc_default_options = {"members": True, "undoc-members": False}
+# Members are listed by autodoc (:members:), not again in a numpydoc table.
+numpydoc_show_class_members = False
+numpydoc_class_members_toctree = False
+# Only the build's warnings decide; numpydoc's style checks are not run.
+numpydoc_validation_checks = set()
+
+html_theme = "alabaster"
+html_title = f"impactsym {release}"
+# MathJax is loaded from a CDN by the reader's browser; the build itself needs no network.
+
+# The docstrings are plain text, where |x| is an absolute value (|ΔV|, |P|,
+# |e_m|), never a reStructuredText substitution. Escape such bars before
+# docutils reads them, outside ``literals`` and `code` spans (where a backslash
+# would be shown). Everything else in a docstring is left as written.
+_CODE_SPAN = re.compile(r"(``.+?``|`[^`]+`)")
+_BAR = re.compile(r"(?<!\\)\|")
+
+
+def _escape_bars(line: str) -> str:
+    pieces = _CODE_SPAN.split(line)
+    return "".join(p if i % 2 else _BAR.sub(r"\\|", p) for i, p in enumerate(pieces))
+
+
+def _plain_docstring(app, what, name, obj, options, lines):
+    lines[:] = [_escape_bars(line) for line in lines]
+
+
+def setup(app):
+    app.connect("autodoc-process-docstring", _plain_docstring)

@@ -1,0 +1,159 @@
+"""The validation report (impactsym/validation.py) against published crash data.
+
+Tolerances were chosen BEFORE running the models on the data (written into this
+file before the first run), with the reasoning beside each; where the data are
+known inconsistent the test asserts that the report says so, never a tuned bound.
+A bound here that the models miss is a finding to report, not to loosen.
+
+- NHTSA 4364/4438/4474 (Rose et al. 2006): the same rigid model on the published
+  inputs must reproduce the published PIM results. Energies are printed to the
+  ft·lb and the inputs to 0.1 ft / 0.1° (README: a careful reproduction agrees to
+  about 1 %): total energy loss within 2 %, its normal/tangential split within 5 %
+  (the split moves with the impact-centre angle), delta-V within 3 %, final yaw
+  rates (printed as unsigned integers, sensitive to d at 0.1 ft) within 15 %; the
+  measured delta-V (within 0.5 % of the published PIM) within 5 %.
+- IIHS barrier tests with Brach's fitted e, μ, d, φ, Γ: the fits reproduce their
+  own tests, but every car is given the Fusion's k (inertia unknown): |ΔV| median
+  5 %, worst 15 %; yaw-rate change (∝ 1/k² for a given impulse) median 15 %,
+  worst 50 %; the source's own outlier CF11006 is excluded.
+- RICSAC CRASH3: CRASH3's delta-V is known to scatter by tens of percent (the
+  seed's Tables 6 and 8; Neades): with Neades' adjustments median |error| against
+  the Brach & Smith measured delta-V within 25 %, with the published profiles within
+  35 %; no worst-case bound (crush data of 1978 with known defects). Our
+  published-profile run against Neades' raw CRASH delta-V (the same inputs, a
+  different implementation): median within 15 %. Our crush energies against
+  Woolley's 1985 CRASH3 energies (same profiles): median within 20 %.
+- RICSAC rigid model with Brach's e and μ = μ_c and an approximated impact centre:
+  delta-V median within 20 % of the measured (Brach & Smith), energy loss median
+  within 25 % of Brach's PIM loss.
+"""
+
+import math
+
+import pytest
+
+from impactsym import validation
+
+BOUNDS = {
+    # (dataset, model, quantity, reference): (median bound %, worst bound % or None)
+    ("nhtsa", "rigid PIM", "energy loss", "published PIM"): (2.0, 2.0),
+    ("nhtsa", "rigid PIM", "normal energy loss", "published PIM"): (5.0, 5.0),
+    ("nhtsa", "rigid PIM", "tangential energy loss", "published PIM"): (5.0, 5.0),
+    ("nhtsa", "rigid PIM", "delta-V", "published PIM"): (3.0, 3.0),
+    ("nhtsa", "rigid PIM", "final yaw rate", "published PIM"): (15.0, 15.0),
+    ("nhtsa", "rigid PIM", "delta-V", "measured"): (5.0, 5.0),
+    ("iihs", "rigid PIM (Brach's fits)", "delta-V", "measured"): (5.0, 15.0),
+    ("iihs", "rigid PIM (Brach's fits)", "yaw-rate change", "measured"): (15.0, 50.0),
+    ("ricsac", "CRASH3 (Neades' adjustments)", "delta-V", "measured, Brach & Smith 2002"): (25.0, None),
+    ("ricsac", "CRASH3 (published profiles)", "delta-V", "measured, Brach & Smith 2002"): (35.0, None),
+    ("ricsac", "CRASH3 (published profiles)", "delta-V", "Neades' raw CRASH"): (15.0, None),
+    ("ricsac", "CRASH3 (published profiles)", "energy loss", "Woolley's CRASH3 (1985)"): (20.0, None),
+    ("ricsac", "rigid PIM (approx. impact centre)", "delta-V", "measured, Brach & Smith 2002"): (20.0, None),
+    ("ricsac", "rigid PIM (approx. impact centre)", "energy loss", "Brach's PIM (SAE 871993)"): (25.0, None),
+}
+
+
+@pytest.fixture(scope="module")
+def datasets():
+    return {ds.name: ds for ds in validation.report()}
+
+
+def comparison(datasets, key):
+    dataset, model, quantity, reference = key
+    found = [c for c in datasets[dataset].comparisons
+             if (c.model, c.quantity, c.reference) == (model, quantity, reference)]
+    assert len(found) == 1, key
+    return found[0]
+
+
+# Bounds chosen before looking that the first run MISSED: kept as chosen, run as
+# strict xfails (the test fails if the miss ever disappears), and reported in
+# docs/validation.md. Our crush energies reproduce Woolley's 1985 CRASH3 energies
+# within 1-4 % in the five tests with small PDOFs (3, 4, 5, 11, 12) but exceed them
+# by 33-207 % in the oblique and side tests: Woolley's side inputs differ from the
+# category defaults Neades published (even uncorrected, test 1 gives 67 000 ft·lb
+# against his 48 392), and the capped correction doubles the side energies.
+MISSED = {("ricsac", "CRASH3 (published profiles)", "energy loss", "Woolley's CRASH3 (1985)"):
+          "first run: median 32.5 %, worst 207 % (bound 20 %): Woolley's 1985 side-impact "
+          "inputs differ from the published defaults"}
+
+
+def _cases():
+    return [pytest.param(key, marks=pytest.mark.xfail(strict=True, reason=MISSED[key]))
+            if key in MISSED else key for key in sorted(BOUNDS)]
+
+
+@pytest.mark.parametrize("key", _cases(), ids=lambda k: " | ".join(k))
+def test_errors_within_the_bounds_chosen_before_looking(datasets, key):
+    stats = comparison(datasets, key).stats()
+    median, worst = BOUNDS[key]
+    assert stats["n"] > 0
+    assert stats["median"] <= median, stats
+    if worst is not None:
+        assert stats["worst"] <= worst, stats
+
+
+def test_every_row_is_run(datasets):
+    ricsac = datasets["ricsac"]
+    assert len(ricsac.tables["crash3 published"]) == 24
+    assert len(ricsac.tables["energy"]) == 11               # test 2 has no energies
+    assert len(ricsac.tables["pim"]) == 11                  # Vossou has no test 2
+    assert len(datasets["iihs"].tables["barrier"]) == 41
+    assert len(datasets["nhtsa"].tables["nhtsa"]) == 6
+    measured = comparison(datasets, ("ricsac", "CRASH3 (Neades' adjustments)", "delta-V",
+                                     "measured, Brach & Smith 2002"))
+    assert len(measured.rows) == 22                         # 11 tests with accelerometers
+
+
+def test_side_impacts_beyond_45_degrees_are_capped(datasets):
+    """The struck cars of the 60° tests have PDOF 30° on a side face: α = -60°,
+    beyond EDCRASH's cap in the published data; Neades' adjusted PDOFs are not."""
+    published = {r["vehicle"]: r for r in datasets["ricsac"].tables["crash3 published"]}
+    adjusted = {r["vehicle"]: r for r in datasets["ricsac"].tables["crash3 neades"]}
+    for key in ("1.2", "2.2", "6.2", "7.2"):
+        assert published[key]["alpha"] == -60.0 and published[key]["capped"]
+        assert not adjusted[key]["capped"]
+
+
+def test_crush_energy_above_the_initial_kinetic_energy_is_flagged(datasets):
+    """Physically impossible results are flagged, never silently returned."""
+    energy = datasets["ricsac"].tables["energy"]
+    flagged = {r["test"] for r in energy if r["impossible"]}
+    assert flagged == {r["test"] for r in energy
+                       if max(r["published"], r["published, woolley"], r["neades"]) > r["initial"]}
+    notes = [n for n in datasets["ricsac"].notes if n.startswith("PHYSICALLY IMPOSSIBLE")]
+    assert len(notes) == len(flagged)
+
+
+def test_cg_and_effective_mass_delta_v(datasets):
+    for row in datasets["ricsac"].tables["crash3 neades"]:
+        assert row["dv"] == pytest.approx(row["gamma"] * row["dv_eff"], rel=1e-12)
+    for row in datasets["ricsac"].tables["crash3 neades, gamma = 1"]:
+        assert row["gamma"] == 1.0 and row["dv"] == row["dv_eff"]
+
+
+def test_the_report_says_the_separation_velocities_are_inconsistent(datasets):
+    momentum = datasets["ricsac"].tables["momentum"]
+    worst = max(abs(r["x_pct"]) for r in momentum)
+    assert worst > 10.0                                     # README: up to ~22 % in x
+    assert any("do not conserve momentum" in note for note in datasets["ricsac"].notes)
+
+
+def test_statistics_are_of_the_rows():
+    c = validation.Comparison("d", "m", "q", "r", (("a", 11.0, 10.0), ("b", 8.0, 10.0), ("c", 10.5, 10.0)))
+    assert c.errors == pytest.approx([10.0, -20.0, 5.0])
+    assert c.stats() == {"n": 3, "median": pytest.approx(10.0), "worst": pytest.approx(20.0),
+                         "bias": pytest.approx(5.0)}
+    assert math.isnan(validation.stats([])["median"])
+
+
+def test_cli_validate(capsys, tmp_path):
+    from impactsym.cli import main
+
+    assert main(["validate"]) == 0
+    out = capsys.readouterr().out
+    assert all(name in out for name in ("ricsac", "iihs", "nhtsa"))
+    assert main(["validate", "--markdown", "--plots", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "| model | quantity | reference |" in out and "PHYSICALLY IMPOSSIBLE" in out
+    assert {p.name for p in tmp_path.glob("*.png")} == {"ricsac.png", "iihs.png", "nhtsa.png"}
