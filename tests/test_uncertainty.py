@@ -21,7 +21,7 @@ from mpmath import mp
 from impactsym import _kernels, solve_batch
 from impactsym import propagation as U
 
-from . import reference
+from impactsym.testing import reference
 
 SCENE = {"m1": 1500.0, "m2": 1200.0, "I1": 2500.0, "I2": 2000.0, "v1x": 20.0, "v1y": 0.0,
          "w1": 0.1, "v2x": 0.0, "v2y": 15.0, "w2": 0.0, "r1x": 2.0, "r1y": 0.3, "r2x": -0.5,
