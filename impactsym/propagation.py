@@ -433,8 +433,9 @@ class _Stats:
     """Count, mean, sd (sums shifted by the nominal value) and percentiles of
     one output over accepted draws: exact from the values kept in memory up to
     `KEEP` draws, beyond that from a `HISTOGRAM_BINS`-bin histogram whose
-    range is set by the first chunk (widened by half its span each side;
-    values outside it are counted and bounded by the running min and max)."""
+    range is set by the first KEEP values and more (widened by half their span
+    each side; values outside it are counted and bounded by the running min
+    and max)."""
 
     def __init__(self, shift: float):
         self.shift = shift if math.isfinite(shift) else 0.0
@@ -453,13 +454,16 @@ class _Stats:
         self.s1 += float(d.sum())
         self.s2 += float((d * d).sum())
         self.lo, self.hi = min(self.lo, float(x.min())), max(self.hi, float(x.max()))
-        if self.kept_n < KEEP:
-            self.kept.append(x[: KEEP - self.kept_n].copy())
-            self.kept_n += min(x.size, KEEP - self.kept_n)
-        if self.hist is None:
-            span = max(self.hi - self.lo, abs(self.shift) * 1e-12, 1e-300)
-            self.edges = (self.lo - span / 2, self.hi + span / 2)
+        if self.hist is None and self.n <= KEEP:
+            self.kept.append(x.copy())
+            self.kept_n = self.n
+            return
+        if self.hist is None:  # past KEEP: the histogram starts from the values kept
+            first = np.concatenate(self.kept + [x])
+            span = max(float(first.max() - first.min()), abs(self.shift) * 1e-12, 1e-300)
+            self.edges = (float(first.min()) - span / 2, float(first.max()) + span / 2)
             self.hist = np.zeros(HISTOGRAM_BINS, dtype=np.int64)
+            self.kept, x = [], first
         a, b = self.edges
         pos = (x - a) * (HISTOGRAM_BINS / (b - a))
         inside = (pos >= 0) & (pos < HISTOGRAM_BINS)
@@ -481,7 +485,7 @@ class _Stats:
     def percentiles(self, q=PERCENTILES) -> list[float]:
         if self.n == 0:
             return [math.nan] * len(q)
-        if self.n == self.kept_n:
+        if self.hist is None:
             return [float(v) for v in np.percentile(np.concatenate(self.kept), q)]
         return [self._from_histogram(p) for p in q]
 
@@ -520,10 +524,18 @@ class Uncertainty:
     inputs: tuple[str, ...]
     outputs: dict
     budget: dict
-    draws: Any
+    kept: list = field(repr=False)
     notes: list = field(default_factory=list)
     sobol: dict | None = None
     seed: int | None = None
+    _draws: Any = field(default=None, repr=False)
+
+    @property
+    def draws(self):
+        """The accepted draws (at most `KEEP`) as a DataFrame, built on first use."""
+        if self._draws is None:
+            self._draws = _frame(self.kept)
+        return self._draws
 
     @property
     def summary(self):
@@ -600,7 +612,7 @@ def propagate(source: Source, draws: int = 10_000, seed: int | None = None, sobo
                       entropy=entropy, rows=draws)
     stats = {path: _Stats(value) for path, value in nominal["outputs"].items()}
     rejected: dict[str, int] = {}
-    accepted, kept = 0, []
+    accepted, kept, kept_rows = 0, [], 0
     step = max(BLOCK, (chunk_size // BLOCK) * BLOCK)
     for start in range(0, draws, step):
         stop = min(start + step, draws)
@@ -610,7 +622,8 @@ def propagate(source: Source, draws: int = 10_000, seed: int | None = None, sobo
         accepted += int(ok.sum())
         for path, s in stats.items():
             s.add(np.asarray(values[path], dtype=np.float64)[ok])
-        if sum(len(k) for k in kept) < KEEP:
+        if kept_rows < KEEP:
+            kept_rows += int(ok.sum())
             kept.append({**{p: v[ok] for p, v in overrides.items()},
                          **{p: np.broadcast_to(v, ok.shape)[ok] for p, v in values.items()}})
     gradient = _gradients(source, nominal)
@@ -624,7 +637,7 @@ def propagate(source: Source, draws: int = 10_000, seed: int | None = None, sobo
         budget[path] = shares
     result = Uncertainty(command.name, draws, accepted, rejected,
                          tuple(x.path for x in source.inputs), outputs, budget,
-                         _frame(kept), _notes(nominal["flags"], accepted, draws, rejected),
+                         kept, _notes(nominal["flags"], accepted, draws, rejected),
                          seed=int(entropy) if seed is None else seed)
     if sobol:
         result.sobol = sobol_indices(source, draws, seed, stats)
