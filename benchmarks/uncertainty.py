@@ -89,6 +89,9 @@ def end_to_end(draws: int) -> dict:
             "reconstruct_batch_s": t_kernel, "ratio": t_mc / t_kernel}
 
 
+REPS = 200
+
+
 def jacobian_vs_value(rows: int = 200_000) -> dict:
     """Per scene: the plain-Python per-scene function (what the linear method
     runs, once per scene) of each Jacobian kernel against its value kernel's;
@@ -97,18 +100,17 @@ def jacobian_vs_value(rows: int = 200_000) -> dict:
     from impactsym import _kernels, batch
 
     out = {}
-    point = FORWARD
+    point, reps = FORWARD, REPS
     for name, value_ks, values in (("reconstruct", _kernels.RECONSTRUCT, SCENE),
                                    ("rigid", _kernels.KERNELS[("rigid", False, False, "energy")],
                                     point),
                                    ("particle", _kernels.KERNELS[("particle", False, False, "energy")],
                                     point)):
         jac = _kernels.JACOBIAN[name]
-        reps = 200
         t_jac = _best(lambda jac=jac, v=values: [_kernels.run_one(jac, v, jac.outputs)
-                                                 for _ in range(reps)]) / reps
+                                                 for _ in range(REPS)]) / reps
         t_val = _best(lambda ks=value_ks, v=values: [_kernels.run_one(ks, v, ks.outputs)
-                                                     for _ in range(reps)]) / reps
+                                                     for _ in range(REPS)]) / reps
         out[f"{name} per scene (plain Python)"] = {
             "jacobian_us": 1e6 * t_jac, "value_us": 1e6 * t_val, "ratio": t_jac / t_val,
             "jacobian_outputs": len(jac.outputs)}
