@@ -14,6 +14,7 @@ SUBCOMMANDS = {
     "accuracy": "benchmarks.accuracy",
     "inverse": "benchmarks.inverse",
     "performance": "benchmarks.performance",
+    "uncertainty": "benchmarks.uncertainty",
     "trig": "benchmarks.trig",
 }
 

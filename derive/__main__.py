@@ -15,7 +15,8 @@ import os
 import sys
 from pathlib import Path
 
-MODEL_MODULES = ("particle", "planar", "delta_v", "inverse", "reconstruct", "presets", "crash3", "report")
+MODEL_MODULES = ("particle", "planar", "delta_v", "inverse", "reconstruct", "presets", "crash3", "report",
+                 "jacobian")
 # Proved before emission but emitting no module of their own (emit inlines their source).
 PROOF_ONLY_MODULES = ("trig",)
 ROOT = Path(__file__).resolve().parent.parent

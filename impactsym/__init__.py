@@ -13,6 +13,7 @@ on vehicle 1; lower case initial, upper case final).
     table = impactsym.solve_batch(columns, model="rigid")
     grid = impactsym.sweep("examples/two_car_us.json", e=[0.1, 0.2], mu=[0.0, 0.3])
     draws = impactsym.sample("examples/two_car_us.json", {"e": ("uniform", 0, 0.3)}, 1000, seed=1)
+    u = impactsym.uncertainty("case.json", command="reconstruct", draws=100_000, seed=1)
 """
 
 from . import plot
@@ -23,6 +24,7 @@ from .crash3 import crash3
 from .energy import delta_v_from_energy
 from .explore import explore
 from .inverse import invert, invert_batch
+from .propagation import uncertainty
 from .reconstruct import reconstruct, reconstruct_batch
 from .result import Result
 from .scene import MODELS, Impact, Scene, SceneError, Vehicle, load_scene
@@ -35,5 +37,5 @@ __all__ = [
     "FLAG_MESSAGES", "MODELS", "STATUS_MESSAGES", "Impact", "Result", "Scene", "SceneError",
     "Vehicle", "compare", "crash3", "delta_v_from_energy", "describe_flags", "describe_status",
     "explore", "invert", "invert_batch", "load_scene", "percentiles", "plot", "reconstruct",
-    "reconstruct_batch", "sample", "solve", "solve_batch", "sweep",
+    "reconstruct_batch", "sample", "solve", "solve_batch", "sweep", "uncertainty",
 ]

@@ -12,25 +12,35 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from collections.abc import Callable
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
+from . import uncertainty_cli
 from .compare import compare
 from .crash3 import crash3
-from .scene import SceneError
 from .inverse import invert
 from .plot import add_plot_argument, save_plot
 from .reconstruct import reconstruct
 from .result import UNIT_LABELS, json_number, table_cell
+from .scene import SceneError
 from .single import solve
-from .sweep import (CHUNK_SIZE, PERCENTILES, SUMMARY_COLUMNS, SWEEP_PERCENTILES, GridPlan,
-                    SamplePlan, percentiles, summarize, write_frame)
+from .sweep import (
+    CHUNK_SIZE,
+    PERCENTILES,
+    SUMMARY_COLUMNS,
+    SWEEP_PERCENTILES,
+    GridPlan,
+    SamplePlan,
+    percentiles,
+    summarize,
+    write_frame,
+)
 from .sweep import sweep as solve_sweep
 
-__all__ = ["main", "build_parser", "Command", "COMMANDS"]
+__all__ = ["COMMANDS", "Command", "build_parser", "main"]
 
 PROG = "impactsym"
 EXIT_BAD_INPUT = 2
@@ -67,6 +77,7 @@ def _add_solve(parser: argparse.ArgumentParser) -> None:
     ``--plot PATH`` (the scene diagram)."""
     _add_scene(parser)
     add_plot_argument(parser)
+    uncertainty_cli.add_arguments(parser)
 
 
 def _print_result(result, as_json: bool) -> int:
@@ -78,8 +89,11 @@ def _print_result(result, as_json: bool) -> int:
     return 0
 
 
-def _report(result, args: argparse.Namespace) -> int:
-    """Draw the scene diagram (``--plot``), then print the result."""
+def _report(result, args: argparse.Namespace, command: str) -> int:
+    """Draw the scene diagram (``--plot``), then print the result; with
+    ``--uncertainty`` the result with its uncertainty (uncertainty_cli)."""
+    if args.uncertainty:
+        return uncertainty_cli.run(args, command, result)
     if args.plot:
         save_plot(result, args.plot, scene=args.scene)
     return _print_result(result, args.json)
@@ -87,17 +101,17 @@ def _report(result, args: argparse.Namespace) -> int:
 
 def _run_solve(args: argparse.Namespace) -> int:
     """Solve a scene; print JSON (``--json``) or a table."""
-    return _report(solve(args.scene), args)
+    return _report(solve(args.scene), args, "solve")
 
 
 def _run_reconstruct(args: argparse.Namespace) -> int:
     """Reconstruct pre-impact speeds from final motion and headings; print JSON or a table."""
-    return _report(reconstruct(args.scene), args)
+    return _report(reconstruct(args.scene), args, "reconstruct")
 
 
 def _run_invert(args: argparse.Namespace) -> int:
     """Recover the pre-impact motion of an inverse scene; print JSON or a table."""
-    return _report(invert(args.scene), args)
+    return _report(invert(args.scene), args, "invert")
 
 
 def _add_crash3(parser: argparse.ArgumentParser) -> None:
@@ -114,12 +128,18 @@ def _add_crash3(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--correction", default=None, metavar="NAME",
                         help="oblique correction: crash3 (1 + tan^2 alpha, default) or woolley "
                              "(1/cos alpha); both capped at 45 degrees as EDCRASH does")
+    uncertainty_cli.add_arguments(parser, plot=True)
 
 
 def _run_crash3(args: argparse.Namespace) -> int:
     """CRASH3 delta-V from the vehicles' crush tables; print JSON or a table."""
-    return _print_result(crash3(args.scene, restitution=args.restitution, energy=args.energy,
-                                correction=args.correction), args.json)
+    result = crash3(args.scene, restitution=args.restitution, energy=args.energy,
+                    correction=args.correction)
+    if args.uncertainty:
+        return uncertainty_cli.run(args, "crash3", result, restitution=result.restitution,
+                                   energy=result.options.energy,
+                                   correction=result.options.correction)
+    return _print_result(result, args.json)
 
 
 def _add_compare(parser: argparse.ArgumentParser) -> None:
