@@ -41,9 +41,9 @@ def _generated(name: str):
     return importlib.import_module(f"{generated.__name__}.{name}")
 
 
-crash3, delta_v, inverse, jacobian, particle, planar, presets, reconstruct, report = (
-    _generated(name) for name in ("crash3", "delta_v", "inverse", "jacobian", "particle",
-                                  "planar", "presets", "reconstruct", "report"))
+crash3, delta_v, inverse, particle, planar, presets, reconstruct, report = (
+    _generated(name) for name in ("crash3", "delta_v", "inverse", "particle", "planar",
+                                  "presets", "reconstruct", "report"))
 CODES = _generated("codes")
 PRESETS = presets.PRESETS
 COEFFICIENT_INPUTS = presets.COEFFICIENT_INPUTS
@@ -228,10 +228,23 @@ KINETIC_ENERGY = _kernel_set(report, "kinetic_energy")
 # Exact first derivatives (derive/jacobian.py), by value-kernel name: the value
 # outputs plus d_<output>__d_<input> (angles in radians, inputs as the batch
 # columns, gamma rather than the normal's components).
-JACOBIAN = {name: _kernel_set(jacobian, f"{name}_jacobian") for name in (
+JACOBIAN_KERNELS = (
     "rigid", "rigid_critical", "particle", "particle_critical", "rigid_inverse",
     "particle_inverse", "reconstruct", "crash3_energy_2", "crash3_energy_4", "crash3_energy_6",
-    "crash3_delta_v", "crash3_moment_arm", "crash3_radius_of_gyration")}
+    "crash3_delta_v", "crash3_moment_arm", "crash3_radius_of_gyration")
+_LAZY: dict = {}
+
+
+def __getattr__(name: str):
+    """`JACOBIAN` is built on first use: generated/jacobian.py is large, and
+    only uncertainty propagation needs it, so `import impactsym` does not pay
+    for it (PEP 562 module attribute)."""
+    if name != "JACOBIAN":
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    if name not in _LAZY:
+        module = _generated("jacobian")
+        _LAZY[name] = {k: _kernel_set(module, f"{k}_jacobian") for k in JACOBIAN_KERNELS}
+    return _LAZY[name]
 
 
 def _check_model(model: str, models: tuple[str, ...] = MODELS) -> None:
