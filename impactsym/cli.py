@@ -114,12 +114,15 @@ def _add_crash3(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--correction", default=None, metavar="NAME",
                         help="oblique correction: crash3 (1 + tan^2 alpha, default) or woolley "
                              "(1/cos alpha); both capped at 45 degrees as EDCRASH does")
+    add_plot_argument(parser)  # the CRASH3 diagram: crush profiles, depths, PDOF
 
 
 def _run_crash3(args: argparse.Namespace) -> int:
     """CRASH3 delta-V from the vehicles' crush tables; print JSON or a table."""
-    return _print_result(crash3(args.scene, restitution=args.restitution, energy=args.energy,
-                                correction=args.correction), args.json)
+    result = crash3(args.scene, restitution=args.restitution, energy=args.energy, correction=args.correction)
+    if args.plot:
+        save_plot(result, args.plot, scene=args.scene)
+    return _print_result(result, args.json)
 
 
 def _add_compare(parser: argparse.ArgumentParser) -> None:

@@ -61,6 +61,8 @@ from typing import Any
 
 from ._util import require
 from .codes import FLAG_ENERGY_CREATED, FLAG_MU_BEYOND_CRITICAL, FLAG_TENSILE_IMPULSE
+from .crash3 import Crash3Result
+from .plot_crash3 import save_crash3
 from .plot_sweep import save_sweep, sweep
 from .result import UNIT_LABELS
 from .scene import Scene, SceneError, _read_file, load_scene
@@ -142,10 +144,16 @@ def save_plot(scene_or_result: Any, path: str | Path, *, scene: SceneLike | None
     """Draw like :func:`scene` and write the figure to ``path``.
 
     The format follows the suffix (``.png``, ``.svg``, ``.pdf``, ...). Uses a
-    plain Agg canvas (no pyplot, no display needed). Returns the path.
+    plain Agg canvas (no pyplot, no display needed). Returns the path. A
+    CRASH3 result (:func:`impactsym.crash3`, with ``scene=``) is drawn as its
+    CRASH3 diagram (:mod:`impactsym.plot_crash3`).
     Raises :class:`ImportError` (with the install command) without matplotlib
     and :class:`OSError` when the file cannot be written.
     """
+    if isinstance(scene_or_result, Crash3Result):  # crush profiles and PDOFs, not a scene diagram
+        if scene is None or result is not None or options:
+            raise TypeError("save_plot: a CRASH3 result takes only scene= (the scene it was computed from)")
+        return save_crash3(scene_or_result, path, scene, dpi=dpi)
     the_scene, the_result, position = _resolve(scene_or_result, scene, result)
     require("matplotlib", extra="plot", what="a scene diagram", load=False)
     from matplotlib.backends.backend_agg import FigureCanvasAgg
