@@ -607,17 +607,18 @@ def _place_labels(ax) -> None:
         label.set_horizontalalignment(ha)
         label.set_verticalalignment(va)
         if math.hypot(*offset) > _LEADER_FROM:  # far from its anchor: a thin line says whose label it is
-            _leader(ax, label, box)
+            start, end = _leader_segment(ax.transData.transform(label.xy), box)
+            ax.plot(*zip(*ax.transData.inverted().transform([start, end])), color=label.get_color(), lw=0.7,
+                    alpha=0.7, zorder=label.get_zorder() - 0.5, gid="leader")
+            obstacles.add_leader(start, end)
         obstacles.boxes.append(box)
 
 
-def _leader(ax, label, box) -> None:
-    """A thin line from a label's anchor to the nearest point of its box
-    (``box`` in display coordinates), in the label's colour."""
-    x, y = ax.transData.transform(label.xy)
-    end = ax.transData.inverted().transform((min(max(x, box[0]), box[2]), min(max(y, box[1]), box[3])))
-    ax.plot([label.xy[0], end[0]], [label.xy[1], end[1]], color=label.get_color(), lw=0.7, alpha=0.7,
-            zorder=label.get_zorder() - 0.5, gid="leader")
+def _leader_segment(anchor, box):
+    """The leader line of a label (display coordinates): from its anchor to the
+    nearest point of its box."""
+    x, y = anchor
+    return (x, y), (min(max(x, box[0]), box[2]), min(max(y, box[1]), box[3]))
 
 
 class _Obstacles:
@@ -632,12 +633,38 @@ class _Obstacles:
         self.frame, self.paths, self.boxes = np.asarray(frame), paths, boxes
         self.extents = np.array([[*path.get_extents().extents] for path, _, _ in paths]).reshape(-1, 4)
         self.pads = np.array([pad for _, _, pad in paths])
+        self.leaders: list = []
 
-    def best(self, candidates):
+    def add_leader(self, start, end) -> None:
+        """A leader line drawn: later labels neither cover nor cross it."""
+        import numpy as np
+        from matplotlib.path import Path as MplPath
+
+        path = MplPath([start, end])
+        self.paths.append((path, False, 1.0))
+        self.extents = np.vstack([self.extents, path.get_extents().extents])
+        self.pads = np.append(self.pads, 1.0)
+        self.leaders.append(path)
+
+    def _leader_crosses(self, anchor, box) -> bool:
+        """Whether the leader line of a label at ``box`` would cross a placed
+        label's box or another leader line."""
+        from matplotlib.path import Path as MplPath
+        from matplotlib.transforms import Bbox
+
+        start, end = _leader_segment(anchor, box)
+        leader = MplPath([start, end])
+        return (any(leader.intersects_bbox(Bbox([other[:2], other[2:]]), filled=False) for other in self.boxes)
+                or any(leader.intersects_path(other) for other in self.leaders))
+
+    def best(self, candidates, anchor, far):
         """``(conflicts, index)`` of the first free box of ``candidates`` (an
         (N, 4) array of x0, y0, x1, y1), else of the one running into the
         fewest things (leaving the axes counts as many; a path whose extent a
-        box reaches counts without the exact test)."""
+        box reaches counts without the exact test). A box ``far`` from its
+        ``anchor`` (display coordinates) gets a leader line, which should cross
+        no placed label and no other leader: the first free box whose leader
+        crosses is taken only when no box is free with its leader."""
         import numpy as np
         from matplotlib.transforms import Bbox
 
@@ -649,11 +676,18 @@ class _Obstacles:
         e, pad = self.extents, self.pads
         near = (x0 - pad <= e[:, 2]) & (e[:, 0] <= x1 + pad) & (y0 - pad <= e[:, 3]) & (e[:, 1] <= y1 + pad)
         cost = 100 * outside + hits + near.sum(axis=1)
+        crossing = None
         for index in np.flatnonzero((~outside) & (hits == 0)):
             box = Bbox(candidates[index].reshape(2, 2))
-            if not any(self.paths[k][0].intersects_bbox(box.padded(self.pads[k]), filled=self.paths[k][1])
-                       for k in np.flatnonzero(near[index])):
-                return 0, int(index)
+            if any(self.paths[k][0].intersects_bbox(box.padded(self.pads[k]), filled=self.paths[k][1])
+                   for k in np.flatnonzero(near[index])):
+                continue
+            if far[index] and self._leader_crosses(anchor, candidates[index]):
+                crossing = int(index) if crossing is None else crossing
+                continue
+            return 0, int(index)
+        if crossing is not None:  # a free box whose leader crosses: better than a box on something
+            return 0, crossing
         index = int(np.argmin(cost))  # the first of the least crowded
         return int(cost[index]) or 1, index
 
@@ -678,7 +712,8 @@ def _best_position(label, prefer: float, renderer, obstacles: _Obstacles):
                         for (dx, dy), ha, va in candidates])
     size = np.array([half_w + pad, half_h + pad])
     boxes = np.hstack([middles - size, middles + size])
-    cost, index = obstacles.best(boxes)
+    far = np.array([math.hypot(*offset) > _LEADER_FROM for offset, _, _ in candidates])
+    cost, index = obstacles.best(boxes, (0.5 * (centre.x0 + centre.x1), 0.5 * (centre.y0 + centre.y1)), far)
     offset, ha, va = candidates[index]
     return cost, offset, ha, va, tuple(boxes[index])
 
