@@ -17,6 +17,15 @@ equal axes:
   positive), before dashed, after solid;
 - a legend with units.
 
+Labels (vehicle names, ``n``, |ΔV|, PDOF, yaw rates) are placed once the
+figure is laid out: each takes the nearest position around its anchor whose
+box stays inside the axes and touches no other label, arrow, outline, line or
+marker (a label placed far from its anchor gets a thin leader line). The PDOF
+label has one style: where the impulse comes from, degrees clockwise from
+straight ahead and the clock position (straight ahead: the ``heading``, else
+the direction of travel). A CRASH3 result is drawn by
+:mod:`impactsym.plot_crash3` instead (:func:`save_plot` dispatches).
+
 Placement: a scene file gives only ``r_i``, the vector from each centre of
 gravity to the impact centre. The impact centre is put at the origin (or at
 ``impact.position`` when the scene data carry one) and each centre of gravity
