@@ -128,7 +128,8 @@ def _add_crash3(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--correction", default=None, metavar="NAME",
                         help="oblique correction: crash3 (1 + tan^2 alpha, default) or woolley "
                              "(1/cos alpha); both capped at 45 degrees as EDCRASH does")
-    uncertainty_cli.add_arguments(parser, plot=True)
+    add_plot_argument(parser)  # the CRASH3 diagram; with --uncertainty, histograms and budget
+    uncertainty_cli.add_arguments(parser)
 
 
 def _run_crash3(args: argparse.Namespace) -> int:
@@ -139,6 +140,8 @@ def _run_crash3(args: argparse.Namespace) -> int:
         return uncertainty_cli.run(args, "crash3", result, restitution=result.restitution,
                                    energy=result.options.energy,
                                    correction=result.options.correction)
+    if args.plot:
+        save_plot(result, args.plot, scene=args.scene)
     return _print_result(result, args.json)
 
 

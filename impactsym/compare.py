@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Union
 
@@ -104,6 +104,7 @@ class Comparison:
     initial_kinetic_energy: float | None
     rows: tuple[ModelRow, ...]
     skipped: dict[str, str]
+    scene_name: str | None = None  # the scene file's name, for the plot's title
 
     def to_json_dict(self) -> dict[str, Any]:
         """The object printed by ``impactsym compare --json``."""
@@ -156,22 +157,29 @@ class Comparison:
         return "\n".join(lines).rstrip("\n")
 
     def plot(self, path: Union[str, Path]) -> None:
+        """Save :meth:`figure` to `path` (the format follows the suffix; needs
+        matplotlib: ``pip install 'impactsym[plot]'``)."""
+        self.figure().savefig(path, dpi=120)
+
+    def figure(self):
         """Bar charts of |delta-V| per vehicle and of the energy loss (% of the
-        initial kinetic energy, stacked normal/tangential/moment) by model, saved
-        to `path` (needs matplotlib: ``pip install 'impactsym[plot]'``)."""
-        matplotlib = require("matplotlib", extra="plot", what="compare --plot")
+        initial kinetic energy, stacked normal/tangential/moment; CRASH3's crush
+        energy hatched) by model, on a plain Agg figure (no pyplot): titled with
+        the scene's name, each legend outside its axes, headroom above the bars."""
+        require("matplotlib", extra="plot", what="compare --plot", load=False)
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
+        fig = Figure(figsize=(12.0, 4.8), layout="constrained")
+        FigureCanvasAgg(fig)
+        ax_dv, ax_e = fig.subplots(1, 2)
         names = [row.model for row in self.rows]
         x = list(range(len(names)))
-        fig, (ax_dv, ax_e) = plt.subplots(1, 2, figsize=(11, 4.2))
         for k, label in enumerate(self.names):
             ax_dv.bar([i + (k - 0.5) * 0.38 for i in x],
                       [row.vehicles[k].delta_v_magnitude for row in self.rows], 0.38, label=label)
         ax_dv.set_ylabel(f"|delta-V| [{UNIT_LABELS[self.units]['velocity']}]")
-        ax_dv.legend()
+        ax_dv.set_title("|delta-V| by vehicle", fontsize=10)
         bottom = [0.0] * len(names)
         for part in ("normal", "tangential", "moment"):
             heights = [row.energy_percent[part] or 0.0 for row in self.rows]
@@ -181,14 +189,37 @@ class Comparison:
                  else 0.0 for row in self.rows]
         ax_e.bar(x, crash, 0.6, label="crush energy (CRASH3)", hatch="//")
         ax_e.set_ylabel("energy loss [% of initial kinetic energy]")
-        ax_e.margins(y=0.25)
-        ax_e.legend()
+        ax_e.set_title("energy loss by part", fontsize=10)
+        energy_known = self.initial_kinetic_energy is not None
+        if not energy_known:
+            ax_e.text(0.5, 0.5, "not known for a crush-only scene\n(no initial kinetic energy)",
+                      transform=ax_e.transAxes, ha="center", va="center", color="0.3")
+            ax_e.set_yticks([])
         for ax in (ax_dv, ax_e):
             ax.set_xticks(x)
             ax.set_xticklabels(names, rotation=30, ha="right")
-        fig.tight_layout()
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
+            ax.axhline(0.0, color="0.3", lw=0.8)
+            _headroom(ax)
+            if ax is ax_dv or energy_known:
+                ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
+        fig.suptitle(f"{self.scene_name or 'scene'}: model comparison ({self.units} units)")
+        return fig
+
+
+def _headroom(ax, fraction: float = 0.12) -> None:
+    """y limits with ``fraction`` of the bars' span free above the highest bar
+    (and below the lowest, when a bar is negative), zero always shown."""
+    tops = [v for bar in ax.patches for v in (bar.get_y(), bar.get_y() + bar.get_height())]
+    low, high = min(tops + [0.0]), max(tops + [0.0])
+    span = (high - low) or 1.0
+    ax.set_ylim(low - fraction * span if low < 0 else 0.0, high + fraction * span)
+
+
+def _scene_name(scene: Union[Scene, Mapping, str, Path]) -> str | None:
+    """The scene file's name (None for a mapping, or a Scene read from none)."""
+    if isinstance(scene, Scene):
+        return scene.source.name if scene.source is not None else None
+    return None if isinstance(scene, Mapping) else Path(scene).name
 
 
 def compare(scene: Union[Scene, Mapping, str, Path]) -> Comparison:
@@ -200,7 +231,7 @@ def compare(scene: Union[Scene, Mapping, str, Path]) -> Comparison:
     try:
         base = _base_scene(data)
     except SceneError as exc:
-        return _crush_only(data, exc)
+        return replace(_crush_only(data, exc), scene_name=_scene_name(scene))
     # every model sees the normal in the sense the geometry chose (the particle
     # model has no impact points to choose it by)
     data = {**data, "impact": {**data["impact"], "normal_angle": base.impact.normal_angle}}
@@ -216,7 +247,7 @@ def compare(scene: Union[Scene, Mapping, str, Path]) -> Comparison:
         raise SceneError("no model can solve this scene: "
                          + "; ".join(f"{n}: {r}" for n, r in skipped.items()))
     names = (base.vehicles[0].name, base.vehicles[1].name)
-    return Comparison(base.units, names, initial, tuple(rows), skipped)
+    return Comparison(base.units, names, initial, tuple(rows), skipped, _scene_name(scene))
 
 
 def _crush_only(data: Mapping, forward_error: SceneError) -> Comparison:

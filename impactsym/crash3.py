@@ -516,3 +516,11 @@ def _short(value: Any) -> str:
     """A value shortened for a one-line error message."""
     text = repr(value)
     return text if len(text) <= 60 else text[:57] + "..."
+
+
+def crush_tables(scene: Union[Scene, Mapping, str, Path]) -> tuple[Crush | None, ...]:
+    """Each vehicle's validated ``crush`` table (None for a fixed body), as
+    :func:`crash3` reads them (for the CRASH3 diagram of :mod:`impactsym.plot_crash3`)."""
+    parsed = load_scene(scene_data(scene), kind="crash3")
+    return tuple(None if v.fixed else _parse_crush(v.extra["crush"], f"vehicles[{i}].crush", parsed.units)
+                 for i, v in enumerate(parsed.vehicles))

@@ -302,6 +302,7 @@ class Explorer:
         limits = _grown(self._limits, limits)
         ax.set_xlim(*limits[0])
         ax.set_ylim(*limits[1])
+        self._plot._place_labels(ax)  # now that the limits are final
         dynamic = sorted([*ax.patches, *ax.lines, *ax.texts, ax.title], key=lambda artist: artist.get_zorder())
         for artist in dynamic:
             artist.set_animated(True)

@@ -17,6 +17,15 @@ equal axes:
   positive), before dashed, after solid;
 - a legend with units.
 
+Labels (vehicle names, ``n``, |ΔV|, PDOF, yaw rates) are placed once the
+figure is laid out: each takes the nearest position around its anchor whose
+box stays inside the axes and touches no other label, arrow, outline, line or
+marker (a label placed far from its anchor gets a thin leader line). The PDOF
+label has one style: where the impulse comes from, degrees clockwise from
+straight ahead and the clock position (straight ahead: the ``heading``, else
+the direction of travel). A CRASH3 result is drawn by
+:mod:`impactsym.plot_crash3` instead (:func:`save_plot` dispatches).
+
 Placement: a scene file gives only ``r_i``, the vector from each centre of
 gravity to the impact centre. The impact centre is put at the origin (or at
 ``impact.position`` when the scene data carry one) and each centre of gravity
@@ -53,6 +62,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import weakref
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -60,6 +70,8 @@ from typing import Any
 
 from ._util import require
 from .codes import FLAG_ENERGY_CREATED, FLAG_MU_BEYOND_CRITICAL, FLAG_TENSILE_IMPULSE
+from .crash3 import Crash3Result
+from .plot_crash3 import save_crash3
 from .plot_sweep import save_sweep, sweep
 from .result import UNIT_LABELS
 from .scene import Scene, SceneError, _read_file, load_scene
@@ -141,10 +153,16 @@ def save_plot(scene_or_result: Any, path: str | Path, *, scene: SceneLike | None
     """Draw like :func:`scene` and write the figure to ``path``.
 
     The format follows the suffix (``.png``, ``.svg``, ``.pdf``, ...). Uses a
-    plain Agg canvas (no pyplot, no display needed). Returns the path.
+    plain Agg canvas (no pyplot, no display needed). Returns the path. A
+    CRASH3 result (:func:`impactsym.crash3`, with ``scene=``) is drawn as its
+    CRASH3 diagram (:mod:`impactsym.plot_crash3`).
     Raises :class:`ImportError` (with the install command) without matplotlib
     and :class:`OSError` when the file cannot be written.
     """
+    if isinstance(scene_or_result, Crash3Result):  # crush profiles and PDOFs, not a scene diagram
+        if scene is None or result is not None or options:
+            raise TypeError("save_plot: a CRASH3 result takes only scene= (the scene it was computed from)")
+        return save_crash3(scene_or_result, path, scene, dpi=dpi)
     the_scene, the_result, position = _resolve(scene_or_result, scene, result)
     require("matplotlib", extra="plot", what="a scene diagram", load=False)
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -475,9 +493,16 @@ class _Canvas:
         self.ax.plot([point[0]], [point[1]], **style)
         self.points.append(point)
 
-    def text(self, point, label, **style):
-        self.ax.text(point[0], point[1], label, **style)
-        self.points.append(point)
+    def label(self, anchor, text, prefer_deg: float, wrapped: str | None = None, **style):
+        """A label near ``anchor`` (data coordinates); :func:`_place_labels` later
+        moves it around the anchor, trying the screen direction ``prefer_deg`` first
+        and the text ``wrapped`` (on two lines) when the one line finds no free place."""
+        label = self.ax.annotate(text, anchor, xytext=(0.0, 0.0), textcoords="offset points", ha="center",
+                                 va="center", zorder=6, annotation_clip=False,
+                                 bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.75), **style)
+        label.set_in_layout(False)  # kept inside the axes by _place_labels; must not move the layout
+        _PREFERRED[label] = (prefer_deg, wrapped)
+        self.points.append(anchor)
 
     def limits(self, pad: float):
         xs = [p[0] for p in self.points]
@@ -485,12 +510,230 @@ class _Canvas:
         return (min(xs) - pad, max(xs) + pad), (min(ys) - pad, max(ys) + pad)
 
 
+def _angle(vector) -> float:
+    """Direction of a vector, degrees counter-clockwise from +x (the screen
+    direction too: the axes have equal aspect)."""
+    return math.degrees(math.atan2(vector[1], vector[0]))
+
+
+# --------------------------------------------------------------------------- label placement
+
+#: Scene labels (annotations made by ``_Canvas.label``): the screen direction tried
+#: first and the label on two lines (or None).
+_PREFERRED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_RADII = (2.0, 6.0, 11.0, 17.0, 24.0, 32.0, 42.0, 54.0, 68.0, 84.0, 102.0, 122.0, 145.0)  # label distance from its anchor [points]
+_DIRECTIONS = 24
+_LEADER_FROM = 14.0  # labels further than this from their anchor [points] get a leader line
+
+
+def _candidates(prefer_deg: float):
+    """``(offset in points, ha, va)`` around an anchor: nearest first, and at each
+    distance the directions closest to ``prefer_deg`` first. The alignment puts
+    the side of the text facing the anchor at the offset."""
+    angles = sorted((360.0 * i / _DIRECTIONS for i in range(_DIRECTIONS)),
+                    key=lambda a: abs((a - prefer_deg + 180.0) % 360.0 - 180.0))
+    for radius in _RADII:
+        for angle in angles:
+            c, s = math.cos(math.radians(angle)), math.sin(math.radians(angle))
+            ha = "left" if c > 0.38 else "right" if c < -0.38 else "center"
+            va = "bottom" if s > 0.38 else "top" if s < -0.38 else "center"
+            yield (radius * c, radius * s), ha, va
+
+
+def _renderer(fig):
+    canvas = fig.canvas
+    return canvas.get_renderer() if hasattr(canvas, "get_renderer") else fig._get_renderer()
+
+
+def _obstacles(ax, renderer, labels) -> tuple[list, list]:
+    """What a label must not cover, in display coordinates: ``(paths, boxes)``;
+    paths as ``(path, filled, pad)`` (arrows, outlines and lines by their stroke,
+    a hatched barrier or a small filled mark as an area; ``pad`` half the line
+    width), boxes ``(x0, y0, x1, y1)`` for markers and fixed texts."""
+    from matplotlib.patches import FancyArrowPatch
+
+    points = renderer.points_to_pixels(1.0)
+    paths, boxes = [], []
+    for patch in ax.patches:
+        path = patch.get_transform().transform_path(patch.get_path())
+        filled = bool(patch.get_hatch()) or (patch.get_facecolor()[3] > 0 and not isinstance(patch, FancyArrowPatch)
+                                             and len(path.vertices) <= 5)  # a small filled mark (the front ▶)
+        paths += [(part, filled, 0.5 * patch.get_linewidth() * points) for part in _polylines(path)]
+    for line in ax.lines:
+        xy = line.get_xydata()
+        if len(xy) == 1:  # a marker
+            x, y = ax.transData.transform(xy[0])
+            half = (0.5 * line.get_markersize() + line.get_markeredgewidth()) * points
+            boxes.append((x - half, y - half, x + half, y + half))
+        else:
+            path = line.get_transform().transform_path(line.get_path())
+            paths += [(part, False, 0.5 * line.get_linewidth() * points) for part in _polylines(path)]
+    for text in ax.texts:
+        if text not in labels and text.get_visible() and text.get_text():  # e.g. the flags box
+            patch = text.get_bbox_patch()
+            boxes.append(tuple((patch or text).get_window_extent(renderer).extents))
+    return paths, boxes
+
+
+def _polylines(path) -> list:
+    """A display path as plain polylines (curves flattened, closed parts closed):
+    ``Path.intersects_bbox`` would take the placeholder vertex of a CLOSEPOLY
+    code (often (0, 0)) for a real point."""
+    from matplotlib.path import Path as MplPath
+
+    return [MplPath(polygon) for polygon in path.to_polygons(closed_only=False) if len(polygon) > 1]
+
+
+def _place_labels(ax) -> None:
+    """Move each scene label to the nearest position around its anchor where its
+    box (text and background) lies inside the axes and touches no arrow, outline,
+    line, marker or other text (greedy, in drawing order). A label that finds
+    no free place on one line tries two (when it has a two-line form); when
+    still none is free, the position running into the fewest things is kept."""
+    fig = ax.figure
+    if fig.get_layout_engine() is not None:
+        # the final axes position: constrained layout around an equal-aspect axes
+        # settles on its second pass (the first starts from the unshrunk axes)
+        fig.draw_without_rendering()
+        fig.draw_without_rendering()
+    else:
+        ax.apply_aspect()
+    renderer = _renderer(fig)
+    labels = [text for text in ax.texts if text in _PREFERRED]
+    paths, boxes = _obstacles(ax, renderer, labels)
+    obstacles = _Obstacles(ax.bbox.extents, paths, boxes)
+    for label in labels:
+        prefer, wrapped = _PREFERRED[label]
+        best = _best_position(label, prefer, renderer, obstacles)
+        if best[0] and wrapped:  # no free place: try the label on two lines
+            line = label.get_text()
+            label.set_text(wrapped)
+            best = min(best + (line,), _best_position(label, prefer, renderer, obstacles) + (wrapped,),
+                       key=lambda choice: choice[0])
+            label.set_text(best[-1])
+        _, offset, ha, va, box = best[:5]
+        label.xyann = offset
+        label.set_horizontalalignment(ha)
+        label.set_verticalalignment(va)
+        if math.hypot(*offset) > _LEADER_FROM:  # far from its anchor: a thin line says whose label it is
+            start, end = _leader_segment(ax.transData.transform(label.xy), box)
+            ax.plot(*zip(*ax.transData.inverted().transform([start, end])), color=label.get_color(), lw=0.7,
+                    alpha=0.7, zorder=label.get_zorder() - 0.5, gid="leader")
+            obstacles.add_leader(start, end)
+        obstacles.boxes.append(box)
+
+
+def _leader_segment(anchor, box):
+    """The leader line of a label (display coordinates): from its anchor to the
+    nearest point of its box."""
+    x, y = anchor
+    return (x, y), (min(max(x, box[0]), box[2]), min(max(y, box[1]), box[3]))
+
+
+class _Obstacles:
+    """The axes frame, paths and boxes a label's box is checked against
+    (display coordinates). The cheap tests (frame, boxes, path extents) run on
+    all candidate boxes at once; the exact path test only where a box reaches
+    a path's extent."""
+
+    def __init__(self, frame, paths, boxes):
+        import numpy as np
+
+        self.frame, self.paths, self.boxes = np.asarray(frame), paths, boxes
+        self.extents = np.array([[*path.get_extents().extents] for path, _, _ in paths]).reshape(-1, 4)
+        self.pads = np.array([pad for _, _, pad in paths])
+        self.leaders: list = []
+
+    def add_leader(self, start, end) -> None:
+        """A leader line drawn: later labels neither cover nor cross it."""
+        import numpy as np
+        from matplotlib.path import Path as MplPath
+
+        path = MplPath([start, end])
+        self.paths.append((path, False, 1.0))
+        self.extents = np.vstack([self.extents, path.get_extents().extents])
+        self.pads = np.append(self.pads, 1.0)
+        self.leaders.append(path)
+
+    def _leader_crosses(self, anchor, box) -> bool:
+        """Whether the leader line of a label at ``box`` would cross a placed
+        label's box or another leader line."""
+        from matplotlib.path import Path as MplPath
+        from matplotlib.transforms import Bbox
+
+        start, end = _leader_segment(anchor, box)
+        leader = MplPath([start, end])
+        return (any(leader.intersects_bbox(Bbox([other[:2], other[2:]]), filled=False) for other in self.boxes)
+                or any(leader.intersects_path(other) for other in self.leaders))
+
+    def best(self, candidates, anchor, far):
+        """``(conflicts, index)`` of the first free box of ``candidates`` (an
+        (N, 4) array of x0, y0, x1, y1), else of the one running into the
+        fewest things (leaving the axes counts as many; a path whose extent a
+        box reaches counts without the exact test). A box ``far`` from its
+        ``anchor`` (display coordinates) gets a leader line, which should cross
+        no placed label and no other leader: the first free box whose leader
+        crosses is taken only when no box is free with its leader."""
+        import numpy as np
+        from matplotlib.transforms import Bbox
+
+        x0, y0, x1, y1 = (candidates[:, i:i + 1] for i in range(4))
+        fx0, fy0, fx1, fy1 = self.frame
+        outside = ~((fx0 <= x0) & (x1 <= fx1) & (fy0 <= y0) & (y1 <= fy1))[:, 0]
+        b = np.array(self.boxes, dtype=float).reshape(-1, 4)
+        hits = ((x0 < b[:, 2]) & (b[:, 0] < x1) & (y0 < b[:, 3]) & (b[:, 1] < y1)).sum(axis=1)
+        e, pad = self.extents, self.pads
+        near = (x0 - pad <= e[:, 2]) & (e[:, 0] <= x1 + pad) & (y0 - pad <= e[:, 3]) & (e[:, 1] <= y1 + pad)
+        cost = 100 * outside + hits + near.sum(axis=1)
+        crossing = None
+        for index in np.flatnonzero((~outside) & (hits == 0)):
+            box = Bbox(candidates[index].reshape(2, 2))
+            if any(self.paths[k][0].intersects_bbox(box.padded(self.pads[k]), filled=self.paths[k][1])
+                   for k in np.flatnonzero(near[index])):
+                continue
+            if far[index] and self._leader_crosses(anchor, candidates[index]):
+                crossing = int(index) if crossing is None else crossing
+                continue
+            return 0, int(index)
+        if crossing is not None:  # a free box whose leader crosses: better than a box on something
+            return 0, crossing
+        index = int(np.argmin(cost))  # the first of the least crowded
+        return int(cost[index]) or 1, index
+
+
+def _best_position(label, prefer: float, renderer, obstacles: _Obstacles):
+    """``(conflicts, offset, ha, va, box)``: the first free candidate position
+    of ``label``, or the one running into the fewest things. The text's size
+    is measured once; a candidate's box follows from its offset and alignment."""
+    import numpy as np
+
+    points = renderer.points_to_pixels(1.0)
+    pad = 0.25 * label.get_fontsize() * points  # the background box around the text
+    label.xyann = (0.0, 0.0)
+    label.set_horizontalalignment("center")
+    label.set_verticalalignment("center")
+    centre = label.get_window_extent(renderer)
+    half_w, half_h = 0.5 * centre.width, 0.5 * centre.height
+    shift = {"left": 1.0, "right": -1.0, "center": 0.0, "bottom": 1.0, "top": -1.0}
+    candidates = list(_candidates(prefer))
+    middles = np.array([(0.5 * (centre.x0 + centre.x1) + dx * points + shift[ha] * half_w,
+                         0.5 * (centre.y0 + centre.y1) + dy * points + shift[va] * half_h)
+                        for (dx, dy), ha, va in candidates])
+    size = np.array([half_w + pad, half_h + pad])
+    boxes = np.hstack([middles - size, middles + size])
+    far = np.array([math.hypot(*offset) > _LEADER_FROM for offset, _, _ in candidates])
+    cost, index = obstacles.best(boxes, (0.5 * (centre.x0 + centre.x1), 0.5 * (centre.y0 + centre.y1)), far)
+    offset, ha, va = candidates[index]
+    return cost, offset, ha, va, tuple(boxes[index])
+
+
 def _rotated(centre, heading_deg, local):
     c, s = math.cos(math.radians(heading_deg)), math.sin(math.radians(heading_deg))
     return [(centre[0] + c * x - s * y, centre[1] + s * x + c * y) for x, y in local]
 
 
-def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, title: str | None):
+def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, title: str | None,
+          place_labels: bool = True):
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
@@ -519,8 +762,8 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
                        _add(_add(centre, _scale(t, half)), _scale(n, side * depth)),
                        _add(_add(centre, _scale(t, -half)), _scale(n, side * depth))]
             canvas.polygon(corners, facecolor="0.9", edgecolor="0.2", hatch="///", lw=1.2, zorder=1)
-            canvas.text(_add(_add(centre, _scale(t, 0.75 * half)), _scale(n, side * (depth + 0.12 * size))),
-                        body.name, ha="center", va="center", fontsize=9, color="0.2", zorder=6)
+            canvas.label(_add(_add(centre, _scale(t, 0.75 * half)), _scale(n, side * depth)),
+                         body.name, _angle(_scale(n, side)), fontsize=9, color="0.2")
             handles.append(Patch(facecolor="0.9", edgecolor="0.2", hatch="///", label="fixed barrier"))
             continue
         fill, edge = _FILL[index], _EDGE[index]
@@ -540,9 +783,7 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
             handles.append(Line2D([], [], ls="none", marker="o", ms=10, mfc=fill, mec=edge, label=body.name))
         canvas.marker(body.cg, ls="none", marker="o", ms=7, mfc="white", mec="black", mew=1.2, zorder=7)
         canvas.marker(body.cg, ls="none", marker="+", ms=7, mec="black", mew=1.2, zorder=8)
-        label_at = _add(body.cg, _scale(t, -0.3 * size))
-        canvas.text(label_at, body.name, ha="center", va="center", fontsize=9, color=edge, zorder=6,
-                    bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.7))
+        canvas.label(body.cg, body.name, _angle(_scale(t, -1.0)), fontsize=9, color=edge)
 
     # crush surface, normal, impact centre
     half = 1.2 * reach
@@ -550,8 +791,7 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
                 color=_COLOR["surface"], lw=2.5, zorder=3)
     tip = _add(centre, _scale(n, 0.6 * size))
     canvas.arrow(centre, tip, _COLOR["normal"], lw=1.5, zorder=6)
-    canvas.text(_add(tip, _scale(n, 0.1 * size)), "n", ha="center", va="center", fontsize=11,
-                fontweight="bold", zorder=6)
+    canvas.label(tip, "n", _angle(n), fontsize=11, fontweight="bold")
     canvas.marker(centre, ls="none", marker="X", ms=10, mfc="black", mec="white", zorder=9)
 
     # motion
@@ -567,17 +807,14 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
             tail = _add(body.cg, _scale(body.v0, k)) if body.v0 is not None else body.cg
             head = _add(tail, _scale(body.dv, k))
             canvas.arrow(tail, head, _COLOR["delta_v"], lw=2.0, ls="--", zorder=5)
-            middle = _scale(_add(tail, head), 0.5)
-            canvas.text(middle, f"|ΔV| {_norm(body.dv):.3g}", fontsize=8, color=_COLOR["delta_v"],
-                        ha="left", va="bottom", zorder=6)
+            canvas.label(_scale(_add(tail, head), 0.5), f"|ΔV| {_norm(body.dv):.3g}",
+                         _angle((-body.dv[1], body.dv[0])), fontsize=8, color=_COLOR["delta_v"])
             drawn.add("delta_v")
         if body.force is not None and not body.fixed:
             tail = _sub(body.cg, _scale(body.force, 0.75 * size))
             canvas.arrow(tail, body.cg, _COLOR["pdof"], lw=1.8, ls="-.", zorder=6, scale=12)
-            side = _scale((-body.force[1], body.force[0]), 0.12 * size)  # the two labels on opposite sides
-            canvas.text(_add(_sub(tail, _scale(body.force, 0.08 * size)), side),
-                        f"{body.name}: {_pdof_label(body)}", fontsize=8, color=_COLOR["pdof"],
-                        ha="center", va="center", zorder=6)
+            canvas.label(tail, f"{body.name}: {_pdof_label(body)}", _angle(_scale(body.force, -1.0)),
+                         wrapped=f"{body.name}:\n{_pdof_label(body)}", fontsize=8, color=_COLOR["pdof"])
             drawn.add("pdof")
         for rate, radius, ls, key in ((body.w0, 0.28, "--", "yaw_before"), (body.w1, 0.4, "-", "yaw_after")):
             if rate is None or wmax <= 0 or abs(rate) <= 1e-9 * wmax:
@@ -586,7 +823,7 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
             start = 100.0 if index == 0 else -80.0
             color = _COLOR["before"] if key == "yaw_before" else _COLOR["after"]
             end = canvas.arc(body.cg, radius * size, start, span, color, ls)
-            canvas.text(end, f" {rate:+.3g}", fontsize=8, color=color, ha="left", va="center", zorder=6)
+            canvas.label(end, f"{rate:+.3g}", _angle(_sub(end, body.cg)), fontsize=8, color=color)
             drawn.add(key)
 
     handles += [
@@ -600,7 +837,7 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
         "before": (dict(color=_COLOR["before"], lw=2.2), f"velocity before [{speed_unit}]"),
         "after": (dict(color=_COLOR["after"], lw=2.2), f"velocity after [{speed_unit}]"),
         "delta_v": (dict(color=_COLOR["delta_v"], lw=2.0, ls="--"), f"delta-V [{speed_unit}]"),
-        "pdof": (dict(color=_COLOR["pdof"], lw=1.8, ls="-."), "PDOF: impulse on vehicle [°]"),
+        "pdof": (dict(color=_COLOR["pdof"], lw=1.8, ls="-."), "PDOF: impulse on vehicle\n[° clockwise from heading]"),
         "yaw_before": (dict(color=_COLOR["before"], lw=1.6, ls="--"), "yaw rate before [rad/s] (ccw +)"),
         "yaw_after": (dict(color=_COLOR["after"], lw=1.6), "yaw rate after [rad/s] (ccw +)"),
     }
@@ -626,6 +863,8 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
     legend_title = f"arrows: 1 {length_unit} = {1.0 / k:.3g} {speed_unit}"
     if legend:
         _legend(ax, handles, legend_title)
+    if place_labels:
+        _place_labels(ax)
     return handles, legend_title
 
 
@@ -637,23 +876,28 @@ def _legend(ax, handles, title: str):
 
 def _render(ax, scene_or_result: Any, *, scene: SceneLike | None = None,
             velocity_scale: float | None = None, title: str | None = None):
-    """Draw like :func:`scene` but without the legend; return ``(handles, legend title)``
-    for :func:`_legend` (the explorer adds the legend only when it changes)."""
+    """Draw like :func:`scene` but without the legend and with the labels at
+    their anchors; return ``(handles, legend title)`` for :func:`_legend` (the
+    explorer adds the legend only when it changes, and calls :func:`_place_labels`
+    once it has set the limits)."""
     the_scene, the_result, position = _resolve(scene_or_result, scene, None)
-    return _draw(ax, the_scene, the_result, position, velocity_scale, False, title)
+    return _draw(ax, the_scene, the_result, position, velocity_scale, False, title, place_labels=False)
 
 
 def _pdof_label(body: _Body) -> str:
-    """The PDOF as text. With the vehicle's ``heading``: the CRASH3 habit of
+    """The PDOF as text, one style for every vehicle: the CRASH3 habit of
     :mod:`impactsym.reconstruct` (where the impulse comes from, degrees
-    clockwise from straight ahead, and the clock position); without it: the
-    direction of the impulse in the scene frame (counter-clockwise from +x)."""
-    angle = math.degrees(math.atan2(body.force[1], body.force[0]))
-    if body.heading is None:
-        return f"PDOF → {round(angle) % 360}°"
-    clockwise = (body.heading - angle - 180.0 + 180.0) % 360.0 - 180.0
+    clockwise from straight ahead, and the clock position). Straight ahead is
+    the vehicle's ``heading``; without one, its direction of travel before the
+    impact (after it, for a vehicle at rest), else +x."""
+    angle = _angle(body.force)
+    heading = body.heading
+    if heading is None:
+        travel = next((v for v in (body.v0, body.v1) if v is not None and _norm(v) > 0), (1.0, 0.0))
+        heading = _angle(travel)
+    clockwise = (heading - angle - 180.0 + 180.0) % 360.0 - 180.0
     clock = (round(clockwise / 30.0) - 1) % 12 + 1
-    return f"PDOF {clockwise:.0f}° ({clock} o'clock)"
+    return f"PDOF {round(clockwise)}° ({clock} o'clock)"  # an int: no "-0°"
 
 
 def _title(scene: Scene, result: Any) -> str:

@@ -3,8 +3,8 @@
 :func:`sweep` draws a parameter sweep (a tidy frame, one row per grid point,
 as ``impactsym.sweep`` returns): over two varied parameters a heatmap of one
 output with the physically impossible cells (energy created, tensile normal
-impulse, μ beyond μ_c) hatched grey, rows not solved dark grey and the line
-μ = μ_c; over one, lines with the impossible points crossed out.
+impulse, μ beyond μ_c) hatched over their colour, rows not solved dark grey
+and the line μ = μ_c; over one, lines with the impossible points crossed out.
 :func:`save_sweep` writes it to a file. Scene diagrams are in
 :mod:`impactsym.plot`. matplotlib is imported inside the functions
 (``pip install 'impactsym[plot]'``).
@@ -56,7 +56,8 @@ _QUANTITIES = {
     **{f"r{i}{c}": (f"impact point r{i}{c}", "length") for i in "12" for c in "xy"},
 }
 _MASK_STYLE = {
-    "impossible": dict(facecolor=(0.85, 0.85, 0.85, 0.9), edgecolor="0.35", hatch="///", lw=0.0),
+    # translucent: the cell's colour (on the colour scale) shows through the hatch
+    "impossible": dict(facecolor=(1.0, 1.0, 1.0, 0.45), edgecolor="0.15", hatch="///", lw=0.0),
     "not_solved": dict(facecolor="0.3", edgecolor="0.3", lw=0.0),
 }
 
@@ -78,10 +79,11 @@ def sweep(df, x: str, y: str | None = None, color=None, ax=None, units: str | No
       cell edges halfway between neighbouring values (so non-uniform spacing
       works; a single value gets a cell of ±10 %, ±0.5 at zero), with a
       colourbar. Solved rows with ``flags & IMPOSSIBLE_FLAGS`` (energy created,
-      tensile normal impulse, μ not between 0 and μ_c) are not coloured but covered by a hatched grey
-      mask; rows not solved by a dark grey one. With ``mu`` on an axis and a
-      ``mu_c`` column the line μ = μ_c (μ_c against the other parameter) is
-      drawn. The colour scale spans the physical cells only.
+      tensile normal impulse, μ not between 0 and μ_c) keep their colour under
+      a translucent hatched mask; rows not solved are covered by a dark grey
+      one. With ``mu`` on an axis and a ``mu_c`` column the line μ = μ_c (μ_c
+      against the other parameter) is drawn. The colour scale spans every
+      solved cell, physically possible or not.
     - 1-D (``y`` None): ``color`` (a column or a list of columns, default
       ``TL``) against ``x``, impossible points marked with red crosses, rows not
       solved shaded grey; with ``x == "mu"`` a vertical line at μ_c.
@@ -275,7 +277,7 @@ def _sweep_map(ax, df, x: str, y: str, column: str, units: str | None) -> None:
     xs, ys, iy, ix = _grid(df, x, y)
     shape = (len(ys), len(xs))
     solved, impossible = _status_flags(df, len(ix))
-    values = _on_grid(np.where(solved & ~impossible, np.asarray(df[column], dtype=np.float64), np.nan), iy, ix, shape)
+    values = _on_grid(np.where(solved, np.asarray(df[column], dtype=np.float64), np.nan), iy, ix, shape)
     xedges, yedges = _edges(xs), _edges(ys)
     mesh = ax.pcolormesh(xedges, yedges, np.ma.masked_invalid(values), cmap="viridis", gid="values", zorder=1)
     ax.figure.colorbar(mesh, ax=ax, label=_label(column, units))
@@ -322,11 +324,14 @@ def _sweep_line(ax, df, x: str, columns: list[str], units: str | None) -> None:
 
 
 def _finish(ax, xlabel: str, ylabel: str, quantity: str, solved, impossible, handles) -> None:
-    """Axis labels, a title that counts the impossible and unsolved rows, the legend."""
+    """Axis labels, a title that counts the impossible and unsolved rows, the
+    legend below the axes, off the data (a figure legend: constrained layout,
+    as :func:`sweep` and :func:`save_sweep` use, makes room for it)."""
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(f"{quantity}\nphysically impossible: {int(impossible.sum())} of {int(solved.sum())} solved "
                  f"points; not solved: {int((~solved).sum())}", fontsize=10)
     ax.grid(True, lw=0.4, alpha=0.5)
     if handles:
-        ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
+        ax.figure.legend(handles=handles, loc="outside lower center", ncols=min(2, len(handles)), fontsize=8,
+                         frameon=False)

@@ -94,3 +94,23 @@ def test_cli_table_markdown_json_and_plot(capsys, tmp_path):
 def test_cli_compare_formats_are_exclusive(capsys):
     assert main(["compare", str(MODELS_SCENE), "--json", "--markdown"]) == 2
     assert "not allowed with" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("scene", [MODELS_SCENE, ROOT / "examples" / "crash3_two_car_us.json"], ids=lambda p: p.name)
+def test_plot_has_a_title_headroom_and_legends_off_the_bars(scene):
+    from matplotlib.patches import Rectangle
+
+    fig = impactsym.compare(scene).figure()
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    assert fig.get_suptitle().startswith(f"{scene.name}: model comparison")
+    bars = {ax: [p for p in ax.patches if isinstance(p, Rectangle) and p.get_height() != 0] for ax in fig.axes}
+    assert bars[fig.axes[0]]  # |delta-V| (a crush-only scene has no energy percentages)
+    for ax, drawn in bars.items():
+        low, high = ax.get_ylim()
+        # at least 5 % of the axis height free above the highest bar
+        assert max((bar.get_y() + bar.get_height() for bar in drawn), default=low) <= high - 0.05 * (high - low)
+    legends = [ax.get_legend().get_window_extent(renderer) for ax in fig.axes if ax.get_legend()]
+    covered = [(legend, bar) for legend in legends for drawn in bars.values() for bar in drawn
+               if legend.overlaps(bar.get_window_extent(renderer))]
+    assert not covered

@@ -71,7 +71,8 @@ def _grid_of(df, column, x, y):
 
 
 def _legend_texts(ax):
-    return [text.get_text() for text in ax.get_legend().get_texts()]
+    (legend,) = ax.figure.legends  # below the axes, off the data
+    return [text.get_text() for text in legend.get_texts()]
 
 
 # --------------------------------------------------------------------------- heatmap
@@ -87,9 +88,9 @@ def test_impossible_mask_covers_exactly_the_flagged_cells(e_mu):
     np.testing.assert_array_equal(_covered(mask, E, MU), flagged)
     assert not _by_gid(ax, "not_solved")  # every row solved
     (mesh,) = _by_gid(ax, "values")
-    values = mesh.get_array()
-    np.testing.assert_array_equal(np.ma.getmaskarray(values).reshape(flagged.shape), flagged)
-    np.testing.assert_allclose(values.compressed(), _grid_of(e_mu, "TL", "e", "mu")[~flagged])
+    values = mesh.get_array()  # impossible cells keep their colour under the translucent hatch
+    assert not np.ma.getmaskarray(values).any()
+    np.testing.assert_allclose(values.compressed(), _grid_of(e_mu, "TL", "e", "mu").ravel())
     assert plot_sweep.IMPOSSIBLE_LABEL in _legend_texts(ax)
     transposed = plot_sweep.sweep(shuffled, "mu", "e", ax=_axes())  # two flagged runs along each row
     (mask,) = _by_gid(transposed, "impossible")
@@ -155,6 +156,39 @@ def test_colourbar_label_carries_the_quantity_and_units(e_mu):
     assert labels == {"SI": "delta-V dV1 [m/s]", "US": "delta-V dV1 [ft/s]", None: "delta-V dV1"}
     ax = plot_sweep.sweep(e_mu, "e", "mu", ax=_axes(), units="US")
     assert [other.get_ylabel() for other in ax.figure.axes if other is not ax] == ["energy loss TL [ft·lb]"]
+
+
+def test_colour_range_spans_every_solved_cell():
+    """Solved cells, possible or not, lie inside the colour range, which is
+    their min to max; rows not solved are left out (not approaching: NaN outputs)."""
+    df = _frame(normal_angle=np.linspace(-30.0, 80.0, 12), mu=np.linspace(-0.8, 0.6, 8))
+    solved = df["status"].to_numpy() == 0
+    impossible = solved & (df["flags"].to_numpy() & IMPOSSIBLE != 0)
+    assert impossible.any() and (~solved).any()
+    ax = plot_sweep.sweep(df, "normal_angle", "mu", ax=_axes())
+    (mesh,) = _by_gid(ax, "values")
+    tl = df["TL"].to_numpy()[solved]
+    assert mesh.get_clim() == (pytest.approx(tl.min()), pytest.approx(tl.max()))
+    assert tl[impossible[solved]].min() < tl[~impossible[solved]].min()  # the case the old range left out
+
+
+@pytest.mark.parametrize("y", ["mu", None], ids=["heatmap", "lines"])
+def test_the_legend_is_off_the_data(e_mu, y):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(9.0, 6.5), layout="constrained")
+    FigureCanvasAgg(fig)
+    frame = e_mu if y else e_mu[e_mu.e == 0.2]
+    ax = plot_sweep.sweep(frame, "e" if y else "mu", y, ax=fig.add_subplot(), units="SI")
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    (legend,) = fig.legends
+    box = legend.get_window_extent(renderer)
+    for other in fig.axes:  # the data and the colour bar
+        assert not box.overlaps(other.get_window_extent(renderer))
+    assert not box.overlaps(ax.xaxis.label.get_window_extent(renderer))
+    assert box.y1 < ax.get_window_extent(renderer).y0  # below the axes
 
 
 # --------------------------------------------------------------------------- line plot
