@@ -18,6 +18,7 @@ import math
 import os
 import sys
 import threading
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,6 +35,8 @@ if getattr(generated, "IMPACTSYM_GENERATED", None) != "impactsym":
     )
 
 import numpy as np
+
+from . import warmup
 
 
 def _generated(name: str):
@@ -278,11 +281,14 @@ def inverse_kernel_for(model: str) -> KernelSet:
 
 
 def _as_input(value):
-    """A batch input: a float scalar (the same for every row) or a
-    C-contiguous float64 array (one value per row)."""
+    """A batch input: a float scalar (the same for every row) or a writable
+    C-contiguous float64 array (one value per row). A read-only array (pandas'
+    copy-on-write columns, memory maps) is copied: numba types it differently,
+    and a second signature would mean a second compile."""
     if np.ndim(value) == 0:
         return float(value)
-    return np.ascontiguousarray(value, dtype=np.float64)
+    arr = np.ascontiguousarray(value, dtype=np.float64)
+    return arr if arr.flags.writeable else arr.copy()
 
 
 def _columns_for(ks: KernelSet, inputs: list, n: int) -> tuple[list, bool]:
@@ -339,6 +345,60 @@ def _call(ks: KernelSet, driver, parallel: bool, columns: list, outs: list) -> N
     finally:
         if timer is not None:
             timer.cancel()
+    _after_first_batch()
+
+
+_STARTED: list = []
+
+
+def _after_first_batch() -> None:
+    """Once per process, after its first batch: compile every other driver in
+    the background unless that was done on this machine (impactsym.warmup)."""
+    if not _STARTED:
+        _STARTED.append(True)
+        warmup.start_background(generated.__file__, generated_digest())
+
+
+def generated_digest() -> str:
+    """The derive-source hash in generated/'s header: names this generated code."""
+    with open(generated.__file__, encoding="utf-8") as handle:
+        for line in handle:
+            if "sha256" in line:
+                return line.rsplit(" ", 1)[-1].strip()
+    return "unknown"
+
+
+def batch_drivers():
+    """(kernel, parallel, normal) for every numba driver the runtime calls
+    (the Jacobian drivers are not among them: uncertainty evaluates the
+    Jacobian at one scene, with the per-scene function)."""
+    sets = [*KERNELS.values(), DELTA_V, *INVERSE.values(), RECONSTRUCT, *CRASH3_ENERGY.values(),
+            CRASH3_DELTA_V, CRASH3_DELTA_V_ABSORBED, CRASH3_MOMENT_ARM,
+            CRASH3_RADIUS_OF_GYRATION, CRASH3_IMPLIED_PDOF, KINETIC_ENERGY]
+    for ks in sets:
+        for parallel in (True, False):
+            for normal in ((False, True) if ks.angle else (False,)):
+                yield ks, parallel, normal
+
+
+def compile_all(progress: Callable[[str], None] | None = None) -> int:
+    """Compile (or load from numba's cache) every driver of `batch_drivers`
+    with the one signature the runtime calls it with: float64 C arrays in
+    and out, int32 status and flags. Returns how many; then no batch call on
+    this machine waits for the compiler (impactsym.warmup leaves the marker)."""
+    from numba import types
+
+    count = 0
+    for ks, parallel, normal in batch_drivers():
+        driver = ks.driver(parallel, normal)
+        start = time.perf_counter()
+        floats = driver.py_func.__code__.co_argcount - 2
+        driver.compile((types.float64[::1],) * floats + (types.int32[::1],) * 2)
+        count += 1
+        if progress is not None:
+            kind = ("parallel" if parallel else "serial") + (", normal form" if normal else "")
+            progress(f"{ks.name} ({kind}): {time.perf_counter() - start:.1f} s")
+    return count
 
 
 def run_batch(ks: KernelSet, inputs: list, n: int | None = None) -> tuple[dict, np.ndarray, np.ndarray]:

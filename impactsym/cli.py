@@ -12,13 +12,14 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import time
 from collections.abc import Callable
 from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
 
-from . import uncertainty_cli
+from . import _kernels, uncertainty_cli, warmup
 from .compare import compare
 from .crash3 import crash3
 from .inverse import invert
@@ -386,6 +387,27 @@ def _run_validate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _add_compile(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--quiet", action="store_true", help="print nothing")
+    parser.add_argument("--claimed", action="store_true", help=argparse.SUPPRESS)
+
+
+def _run_compile(args: argparse.Namespace) -> int:
+    """Compile every batch driver once for this machine (impactsym.warmup)."""
+    where, digest = _kernels.generated.__file__, _kernels.generated_digest()
+    start = time.perf_counter()
+    try:
+        count = _kernels.compile_all(None if args.quiet else print)
+    except BaseException:
+        warmup.release(where, digest)
+        raise
+    warmup.finish(where, digest)
+    if not args.quiet:
+        print(f"compiled or loaded {count} batch drivers in {time.perf_counter() - start:.0f} s; "
+              f"cache: {warmup.cache_dir(where)}")
+    return 0
+
+
 COMMANDS: dict[str, Command] = {
     "solve": Command(
         "solve the impact of a scene (initial motion -> final motion, impulses, energy loss)",
@@ -422,6 +444,12 @@ COMMANDS: dict[str, Command] = {
         "Monte Carlo: draw inputs from distributions around a scene, print percentiles",
         _add_sample,
         _run_sample,
+    ),
+    "compile": Command(
+        "compile every batch kernel for this machine now (otherwise done once in the background "
+        "after the first batch)",
+        _add_compile,
+        _run_compile,
     ),
     "validate": Command(
         "run the models against published crash tests (RICSAC, IIHS, NHTSA) and report the errors",

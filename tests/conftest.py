@@ -1,0 +1,7 @@
+"""Test-suite settings shared by every test module."""
+
+import os
+
+# The suite compiles the drivers it uses as it goes; a background compile of all
+# the others (impactsym.warmup) would only compete with it for the two cores.
+os.environ.setdefault("IMPACTSYM_BACKGROUND_COMPILE", "0")
