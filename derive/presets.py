@@ -36,14 +36,54 @@ import sympy as sp
 from . import frame as f
 from . import particle, planar, specialise
 from .frame import (
-    I1, I2, M, Pn, Pt, Px, Py, TL, TLm, TLn, TLt, V1x, V1y, V2x, V2y, W1, W2,
-    dvx, dvy, e, e_m, gamma, gn, gt, gx, gy, j1, j2, k1, k2, m1, m2, mu, mu_c,
-    mu_used, r1x, r1y, r2x, r2y, v1x, v1y, v2x, v2y, w1, w2,
+    I1,
+    I2,
+    TL,
+    W1,
+    W2,
+    M,
+    Pn,
+    Pt,
+    Px,
+    Py,
+    TLm,
+    TLn,
+    TLt,
+    V1x,
+    V1y,
+    V2x,
+    V2y,
+    dvx,
+    dvy,
+    e,
+    e_m,
+    gamma,
+    gn,
+    gt,
+    gx,
+    gy,
+    j1,
+    j2,
+    k1,
+    k2,
+    m1,
+    m2,
+    mu,
+    mu_c,
+    mu_used,
+    r1x,
+    r1y,
+    r2x,
+    r2y,
+    v1x,
+    v1y,
+    v2x,
+    v2y,
+    w1,
+    w2,
 )
 from .kernel import Block, Guard, IsFinite, Kernel, finite_inputs, positive_or_fixed, real
-from .planar import (
-    D, Dc, Knn, Knt, Ktt, bn, bt, c1, c2, hn, ht, kk, r12, r1n, r1t, r2n, r2t,
-)
+from .planar import D, Dc, Knn, Knt, Ktt, bn, bt, c1, c2, hn, ht, kk, r1n, r1t, r2n, r2t, r12
 
 slip, Dcrit = real("slip Dcrit")
 

@@ -29,11 +29,10 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Union
-
-from ._kernels import PRESETS
+from typing import Any
 
 from . import _kernels
+from ._kernels import PRESETS
 from ._util import require
 from .crash3 import crash3
 from .result import UNIT_LABELS, Result
@@ -156,7 +155,7 @@ class Comparison:
         lines += [""] + [f"- skipped `{n}`: {reason}" for n, reason in self.skipped.items()]
         return "\n".join(lines).rstrip("\n")
 
-    def plot(self, path: Union[str, Path]) -> None:
+    def plot(self, path: str | Path) -> None:
         """Save :meth:`figure` to `path` (the format follows the suffix; needs
         matplotlib: ``pip install 'impactsym[plot]'``)."""
         self.figure().savefig(path, dpi=120)
@@ -215,14 +214,14 @@ def _headroom(ax, fraction: float = 0.12) -> None:
     ax.set_ylim(low - fraction * span if low < 0 else 0.0, high + fraction * span)
 
 
-def _scene_name(scene: Union[Scene, Mapping, str, Path]) -> str | None:
+def _scene_name(scene: Scene | Mapping | str | Path) -> str | None:
     """The scene file's name (None for a mapping, or a Scene read from none)."""
     if isinstance(scene, Scene):
         return scene.source.name if scene.source is not None else None
     return None if isinstance(scene, Mapping) else Path(scene).name
 
 
-def compare(scene: Union[Scene, Mapping, str, Path]) -> Comparison:
+def compare(scene: Scene | Mapping | str | Path) -> Comparison:
     """Run a forward scene through every model its data allow (see the module
     docstring); a crush-only scene gives the CRASH3 row alone. Raises
     :class:`SceneError` when the scene is neither a valid forward scene nor a

@@ -70,8 +70,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Union
-
+from typing import Any
 
 from . import _kernels
 from ._kernels import FLAG_PDOF_CAPPED
@@ -229,7 +228,7 @@ class Crash3Result:
         return "\n".join(lines)
 
 
-def crash3(scene: Union[Scene, Mapping, str, Path], restitution: float | None = None,
+def crash3(scene: Scene | Mapping | str | Path, restitution: float | None = None,
            energy: str | None = None, correction: str | None = None) -> Crash3Result:
     """CRASH3 delta-V of a scene whose moving vehicles carry ``crush`` tables.
 
@@ -518,7 +517,7 @@ def _short(value: Any) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
-def crush_tables(scene: Union[Scene, Mapping, str, Path]) -> tuple[Crush | None, ...]:
+def crush_tables(scene: Scene | Mapping | str | Path) -> tuple[Crush | None, ...]:
     """Each vehicle's validated ``crush`` table (None for a fixed body), as
     :func:`crash3` reads them (for the CRASH3 diagram of :mod:`impactsym.plot_crash3`)."""
     parsed = load_scene(scene_data(scene), kind="crash3")

@@ -40,7 +40,6 @@ else:
     import tomli as tomllib
 
 from ._kernels import COEFFICIENT_INPUTS, PRESETS
-
 from .casefile import (
     COEFFICIENT_KEYS,
     CRUSH_LEAVES,

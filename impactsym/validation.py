@@ -33,6 +33,7 @@ import statistics
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cache, lru_cache
+from operator import itemgetter
 from pathlib import Path
 from typing import Any
 
@@ -514,7 +515,7 @@ def _ricsac() -> Dataset:
     published, adjusted, no_arm = ricsac_crash3(False), ricsac_crash3(True), ricsac_crash3(True, arm=False)
     ds.tables.update({"crash3 published": published, "crash3 neades": adjusted,
                       "crash3 neades, gamma = 1": no_arm})
-    vehicle = lambda r: r["vehicle"]
+    vehicle = itemgetter("vehicle")
     for label, rows in (("CRASH3 (published profiles)", published),
                         ("CRASH3 (Neades' adjustments)", adjusted),
                         ("CRASH3 (Neades, gamma = 1)", no_arm)):
@@ -529,7 +530,8 @@ def _ricsac() -> Dataset:
     ds.notes += [f"PHYSICALLY IMPOSSIBLE: test {r['test']}: the CRASH3 crush energy ({r['impossible']}) "
                  f"exceeds the initial kinetic energy ({_fmt(r['initial'])} ft lb)"
                  for r in energy if r["impossible"]]
-    test = lambda r: str(r["test"])
+    def test(r):
+        return str(r["test"])
     for label, key in (("CRASH3 (published profiles)", "published"),
                        ("CRASH3 (published, Woolley)", "published, woolley"),
                        ("CRASH3 (Neades' adjustments)", "neades")):
@@ -578,8 +580,10 @@ def _iihs() -> Dataset:
     ds = Dataset("iihs", "IIHS small-overlap barrier tests (41, Brach et al. 2014 fits)")
     rows = iihs_barrier()
     ds.tables["barrier"] = rows
-    keep = lambda r: not r["outlier"]
-    label = lambda r: r["test"]
+    def keep(r):
+        return not r["outlier"]
+
+    label = itemgetter("test")
     for quantity, key in (("delta-V", "dv"), ("longitudinal delta-V", "dvx"),
                           ("lateral delta-V", "dvy"), ("yaw-rate change", "yaw")):
         ds.comparisons.append(_compare("iihs", "rigid PIM (Brach's fits)", quantity, "measured",
@@ -604,7 +608,9 @@ def _nhtsa() -> Dataset:
     ds = Dataset("nhtsa", "NHTSA car-to-SUV tests 4364, 4438, 4474 (Rose et al. 2006)")
     rows = nhtsa()
     ds.tables["nhtsa"] = rows
-    label = lambda r: f"{r['test']} {r['vehicle']}"
+    def label(r):
+        return f"{r['test']} {r['vehicle']}"
+
     per_test = [r for i, r in enumerate(rows) if i % 2 == 0]
     for quantity, key in (("energy loss", "energy_loss"), ("normal energy loss", "normal_loss"),
                           ("tangential energy loss", "tangential_loss")):

@@ -20,7 +20,6 @@ from mpmath import mp
 
 from impactsym import _kernels, solve_batch
 from impactsym import propagation as U
-
 from impactsym.testing import reference
 
 SCENE = {"m1": 1500.0, "m2": 1200.0, "I1": 2500.0, "I2": 2000.0, "v1x": 20.0, "v1y": 0.0,
