@@ -16,6 +16,7 @@ on vehicle 1; lower case initial, upper case final).
 """
 
 from . import plot
+from ._version import __version__
 from .batch import solve_batch
 from .codes import FLAG_MESSAGES, STATUS_MESSAGES, describe_flags, describe_status
 from .compare import compare
@@ -29,11 +30,10 @@ from .scene import MODELS, Impact, Scene, SceneError, Vehicle, load_scene
 from .single import solve
 from .sweep import percentiles, sample, sweep
 
-__version__ = "0.1.0"
 
 __all__ = [
     "FLAG_MESSAGES", "MODELS", "STATUS_MESSAGES", "Impact", "Result", "Scene", "SceneError",
     "Vehicle", "compare", "crash3", "delta_v_from_energy", "describe_flags", "describe_status",
     "explore", "invert", "invert_batch", "load_scene", "percentiles", "plot", "reconstruct",
-    "reconstruct_batch", "sample", "solve", "solve_batch", "sweep",
+    "reconstruct_batch", "sample", "solve", "solve_batch", "sweep", "__version__",
 ]

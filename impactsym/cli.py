@@ -18,6 +18,7 @@ from typing import Callable
 
 import numpy as np
 
+from ._version import __version__
 from .compare import compare
 from .crash3 import crash3
 from .scene import SceneError
@@ -411,6 +412,7 @@ COMMANDS: dict[str, Command] = {
 def build_parser() -> argparse.ArgumentParser:
     """The ``impactsym`` parser with one sub-parser per entry of :data:`COMMANDS`."""
     parser = _Parser(prog=PROG, description="Impact phase of planar vehicle collisions.")
+    parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name, command in COMMANDS.items():
         command.add_arguments(commands.add_parser(name, help=command.help, description=command.help))
