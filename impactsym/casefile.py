@@ -98,12 +98,21 @@ def check_keys(data: Mapping, known: tuple[str, ...], path: str) -> None:
             raise SceneError(unknown_key(str(key), known), f"{path}.{key}" if path else str(key))
 
 
-def unknown_key(key: str, known: tuple[str, ...]) -> str:
-    """``unknown key; did you mean "restitution"?`` (difflib's nearest), or the list."""
-    close = difflib.get_close_matches(key, known, n=1, cutoff=0.6)
+def unknown_key(key: str, known: tuple[str, ...], word: str = "key",
+                aliases: Mapping[str, str] | None = None) -> str:
+    """``unknown key; did you mean "restitution"?`` (difflib's nearest), or the list.
+
+    ``word`` names what ``key`` is (``"column"`` for a batch). ``aliases`` maps
+    other spellings to a known key (a scene's ``restitution`` to a batch's
+    ``e``): a near miss of an alias suggests the key it stands for."""
+    spellings = {name: name for name in known}
+    spellings.update({alias: name for alias, name in (aliases or {}).items() if name in known})
+    close = difflib.get_close_matches(key, tuple(spellings), n=1, cutoff=0.6)
     if close:
-        return f'unknown key; did you mean "{close[0]}"?'
-    return f"unknown key (known here: {', '.join(known)})"
+        target = spellings[close[0]]
+        said = f' ({close[0]})' if target != close[0] else ""
+        return f'unknown {word}; did you mean "{target}"{said}?'
+    return f"unknown {word} (known here: {', '.join(known)})"
 
 
 @dataclass(frozen=True)

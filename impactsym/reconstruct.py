@@ -29,12 +29,14 @@ def reconstruct_batch(columns):
     """Reconstruction for one scene per row.
 
     `columns`: ``m1 m2 I1 I2 V1x V1y W1 V2x V2y W2 theta1 theta2 w1 w2 r1x r1y
-    r2x r2y gamma`` (headings θ and normal angle Γ in radians; w = pre-impact
-    yaw rates). Returns ``s1 s2 v1x v1y v2x v2y Pn Pt M M_residual e mu e_m mu_c
+    r2x r2y gamma`` (headings θ and normal angle Γ in RADIANS: degrees given
+    by mistake give wrong speeds and no flag; w = pre-impact yaw rates), as a
+    dict or DataFrame; an unknown or non-numeric column is a one-line
+    ValueError naming it, as in `solve_batch`. Returns ``s1 s2 v1x v1y v2x v2y Pn Pt M M_residual e mu e_m mu_c
     TL TLn TLt TLm pdof1 pdof2`` (PDOF in radians, counter-clockwise from the
     heading, of the direction the impulse comes from) plus status and flags.
     """
-    return run_columns(_kernels.RECONSTRUCT, columns, OUTPUTS)
+    return run_columns(_kernels.RECONSTRUCT, columns, OUTPUTS, "reconstruction")
 
 
 @dataclass(frozen=True)

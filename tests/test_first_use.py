@@ -7,10 +7,12 @@ answer (exit 2, the field named) or the quiet behaviour the issue asks for.
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import impactsym
 from impactsym.cli import main
+from impactsym.codes import FLAG_E_OUT_OF_RANGE
 from impactsym.scene import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -77,3 +79,81 @@ def test_version(capsys):
     assert (code, err) == (0, "")
     assert out.strip() == f"impactsym {impactsym.__version__}"
     assert impactsym.__version__.count(".") >= 1
+
+
+# --------------------------------------------------------------------------- 2. the batch API
+
+RIGID = dict(m1=1000.0, m2=1500.0, I1=1500.0, I2=2500.0, v1x=15.0, v1y=0.0, w1=0.0, v2x=0.0,
+             v2y=0.0, w2=0.0, r1x=1.0, r1y=0.2, r2x=-1.2, r2y=0.0, gamma=0.0, e=0.2, mu=0.0,
+             e_m=1.0)
+PARTICLE = {k: RIGID[k] for k in ("m1", "m2", "v1x", "v1y", "v2x", "v2y", "gamma", "e", "mu")}
+
+
+def test_empty_columns_give_an_empty_result_with_every_column():
+    out = impactsym.solve_batch({k: np.array([]) for k in RIGID})
+    assert set(out) == {*impactsym.solve_batch(RIGID), "status", "flags"}
+    assert all(len(v) == 0 for v in out.values())
+
+
+def test_unknown_column_is_refused_with_the_nearest_name():
+    with pytest.raises(ValueError, match=r'^restitusion: unknown column; did you mean "e" '
+                                         r'\(restitution\)\?$'):
+        impactsym.solve_batch({**RIGID, "restitusion": 0.2})
+    with pytest.raises(ValueError, match="^e_mm: unknown column; did you mean \"e_m\"\\?$"):
+        impactsym.solve_batch({**RIGID, "e_mm": 1.0})
+
+
+def test_a_column_the_model_does_not_read_is_refused():
+    with pytest.raises(ValueError, match="^I1: given but not used by the particle model"):
+        impactsym.solve_batch({**PARTICLE, "I1": 3.0}, model="particle")
+    with pytest.raises(ValueError, match="^I1: given but not used by the particle model"):
+        finals = {("V" + k[1:]) if k[0] == "v" else k: v for k, v in PARTICLE.items()}
+        impactsym.invert_batch({**finals, "I1": 3.0}, model="particle")
+    with pytest.raises(ValueError, match="^foo: unknown column"):
+        impactsym.reconstruct_batch({"foo": 1.0})
+
+
+@pytest.mark.parametrize("value, said", [
+    (np.array([True, False]), "true/false"),
+    (np.array(["0.2", "0.3"]), "text"),
+    ("0.2", "text"),
+    (None, "None"),
+    (np.array([0.2, None], dtype=object), "None"),
+    (np.zeros(2, dtype=[("a", float), ("b", float)]), "structured array"),
+])
+def test_a_column_that_is_not_numbers_is_one_line_naming_it(value, said):
+    with pytest.raises(ValueError, match=f"^e: .*{said}") as info:
+        impactsym.solve_batch({**RIGID, "e": value})
+    assert "\n" not in str(info.value)
+
+
+def test_numbers_in_an_object_column_are_accepted():
+    out = impactsym.solve_batch({**RIGID, "e": np.array([0.2, 0.3], dtype=object)})
+    assert list(out["status"]) == [0, 0]
+
+
+@pytest.mark.parametrize("columns, said", [
+    ([RIGID, RIGID], "a list"),
+    (np.zeros(2, dtype=[(k, float) for k in RIGID]), "a structured array"),
+    (None, "got NoneType"),
+])
+def test_a_batch_that_is_not_a_mapping_is_one_line(columns, said):
+    for call in (impactsym.solve_batch, impactsym.invert_batch, impactsym.reconstruct_batch):
+        with pytest.raises(ValueError, match=f"^columns: .*{said}"):
+            call(columns)
+
+
+def test_restitution_outside_0_1_is_solved_and_flagged_as_the_scene_warns():
+    e = np.array([-0.3, 0.0, 0.5, 1.0, 1.2])
+    out = impactsym.solve_batch({**RIGID, "e": e})
+    assert list(out["status"]) == [0] * 5
+    marked = (out["flags"] & FLAG_E_OUT_OF_RANGE) != 0
+    assert list(marked) == [True, False, False, False, True]
+    # The scene path solves the same scene and warns.
+    scene = {**SCENE, "impact": {**SCENE["impact"], "restitution": -0.3}}
+    assert any("restitution = -0.3 is outside [0, 1]" in w for w in impactsym.solve(scene).warnings)
+
+
+def test_every_batch_docstring_says_angles_are_radians():
+    for call in (impactsym.solve_batch, impactsym.invert_batch, impactsym.reconstruct_batch):
+        assert "RADIANS" in call.__doc__
