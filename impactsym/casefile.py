@@ -85,6 +85,10 @@ DISTRIBUTIONS = {"normal": ("mean", "sd"), "uniform": ("low", "high"),
 CRUSH_LEAVES = {"A": "stiffness_A", "B": "stiffness_B", "width": "crush_length",
                 "pdof": "angle", "moment_arm": "length", "radius_of_gyration": "length"}
 #: The domain of a leaf: what its nominal value and every draw must satisfy.
+#: The largest |angle| a leaf may give, in degrees. An angle is read modulo
+#: 360, but one beyond a million degrees is a slip of the keyboard (1e300 for
+#: 100), not a direction: it is refused rather than reduced.
+MAX_ANGLE_DEG = 1e6
 DOMAINS = {"any": ("", lambda x: np.isfinite(x)),
            "positive": ("positive ", lambda x: x > 0.0),
            "nonnegative": ("non-negative ", lambda x: x >= 0.0)}
@@ -146,6 +150,8 @@ class LeafReader:
         else:
             leaf = Leaf(path, dimension, domain, self._plain(value, path, dimension, domain))
         _check_domain(leaf.nominal, value, path, domain)
+        if dimension == "angle":
+            _check_angle(leaf.nominal, path)
         self.leaves[path] = leaf
         return leaf.nominal
 
@@ -233,6 +239,13 @@ def _check_domain(nominal: float, raw: Any, path: str, domain: str) -> None:
         word = DOMAINS[domain][0]
         shown = show_value(raw) if not isinstance(raw, Mapping) else f"{nominal:g} (the nominal value)"
         raise SceneError(f"must be a {word}finite number, got {shown}", path)
+
+
+def _check_angle(degrees: float, path: str) -> None:
+    """A SceneError for an angle beyond ±MAX_ANGLE_DEG degrees (scene units)."""
+    if abs(degrees) > MAX_ANGLE_DEG:
+        raise SceneError(f"{degrees:g} degrees is not a usable angle: give it within [-360, 360] "
+                         f"(at most {MAX_ANGLE_DEG:g} degrees in magnitude)", path)
 
 
 def domain_reasons(leaves: Mapping[str, Leaf], values: Mapping[str, Any], n: int) -> np.ndarray:

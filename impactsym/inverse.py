@@ -19,6 +19,7 @@ from .batch import run_columns
 from .codes import describe_flags, describe_status
 from .result import Result, VehicleResult, scene_warnings
 from .scene import Scene, SceneError, load_scene
+from .single import overflow_error
 
 _HINTS = {
     STATUS_NOT_APPROACHING: "for e > 0 the final velocities must separate at the impact centre, "
@@ -52,6 +53,9 @@ def invert(scene: Scene | Mapping | str | Path) -> Result:
     out = _kernels.run_one(_kernels.inverse_kernel_for(scene.family), values,
                            _kernels.INVERSE_OUTPUTS)
     if out["status"] != 0:
+        overflow = overflow_error(scene, out["status"])
+        if overflow:
+            raise overflow
         hint = _HINTS.get(out["status"])
         reason = f"cannot invert the scene: {describe_status(out['status'])}"
         raise SceneError(f"{reason}; {hint}" if hint else reason)

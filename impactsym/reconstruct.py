@@ -20,6 +20,7 @@ from .batch import run_columns
 from .codes import describe_flags, describe_status
 from .result import UNIT_LABELS, json_number, road_speed_rows, table_cell
 from .scene import Scene, SceneError, load_scene
+from .single import overflow_error
 
 OUTPUTS = ("s1", "s2", "v1x", "v1y", "v2x", "v2y", "Pn", "Pt", "M", "M_residual",
            "e", "mu", "e_m", "mu_c", "TL", "TLn", "TLt", "TLm", "pdof1", "pdof2")
@@ -143,7 +144,8 @@ def reconstruct(scene: Scene | Mapping | str | Path) -> Reconstruction:
     values = _inputs(scene)
     out = _kernels.run_one(_kernels.RECONSTRUCT, values, OUTPUTS)
     if out["status"] != 0:
-        raise SceneError(f"cannot reconstruct the scene: {describe_status(out['status'])}")
+        raise overflow_error(scene, out["status"]) or SceneError(
+            f"cannot reconstruct the scene: {describe_status(out['status'])}")
     vehicles = tuple(_vehicle(v, out, values, i) for i, v in enumerate(scene.vehicles, 1))
     scalars = {k: out[k] for k in ("Pn", "Pt", "M", "M_residual", "e", "mu", "e_m", "mu_c",
                                    "TL", "TLn", "TLt", "TLm")}

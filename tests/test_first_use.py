@@ -157,3 +157,43 @@ def test_restitution_outside_0_1_is_solved_and_flagged_as_the_scene_warns():
 def test_every_batch_docstring_says_angles_are_radians():
     for call in (impactsym.solve_batch, impactsym.invert_batch, impactsym.reconstruct_batch):
         assert "RADIANS" in call.__doc__
+
+
+# --------------------------------------------------------------------------- 3. overflow, angles
+
+def _with_vehicle0(**changes):
+    vehicles = [dict(SCENE["vehicles"][0], **changes), SCENE["vehicles"][1]]
+    return {**SCENE, "vehicles": vehicles}
+
+
+@pytest.mark.parametrize("changes, field, size", [
+    ({"velocity": [1e308, 0.0]}, "vehicles[0].velocity[0]", "large"),
+    ({"velocity": [1e200, 0.0]}, "vehicles[0].velocity[0]", "large"),
+    ({"weight": 1e-320}, "vehicles[0].weight", "small"),
+])
+def test_overflow_names_the_input_that_drives_it(changes, field, size):
+    scene = _with_vehicle0(**changes)
+    if "weight" in changes:
+        del scene["vehicles"][0]["mass"]
+    with pytest.raises(impactsym.SceneError) as info:
+        impactsym.solve(scene)
+    assert info.value.field == field
+    assert f"is too {size}" in str(info.value)
+
+
+def test_overflow_is_named_on_the_command_line(tmp_path, capsys):
+    path = tmp_path / "huge.json"
+    path.write_text(json.dumps(_with_vehicle0(velocity=[1e308, 0.0])))
+    assert "vehicles[0].velocity[0]: 1e+308 is too large" in one_line_error(capsys, "solve", path)
+
+
+def test_an_absurd_normal_angle_is_refused_as_an_angle():
+    scene = {**SCENE, "impact": {**SCENE["impact"], "normal_angle": 1e300}}
+    with pytest.raises(impactsym.SceneError, match="not a usable angle") as info:
+        impactsym.solve(scene)
+    assert info.value.field == "impact.normal_angle"
+    # A large but sensible angle (read modulo 360) still solves, as its reduced twin does.
+    turned = {**SCENE, "impact": {**SCENE["impact"],
+                                  "normal_angle": SCENE["impact"]["normal_angle"] + 720}}
+    assert impactsym.solve(turned).vehicles[0].velocity == pytest.approx(
+        impactsym.solve(SCENE).vehicles[0].velocity, rel=1e-12)
