@@ -25,7 +25,7 @@ from .scene import SceneError
 from .inverse import invert
 from .plot import add_plot_argument, save_plot
 from .reconstruct import reconstruct
-from .result import UNIT_LABELS, json_number, table_cell
+from .result import UNIT_LABELS, json_clean, json_number, table_cell
 from .single import solve
 from .sweep import (CHUNK_SIZE, PERCENTILES, SUMMARY_COLUMNS, SWEEP_PERCENTILES, GridPlan,
                     SamplePlan, percentiles, summarize, write_frame)
@@ -73,7 +73,7 @@ def _add_solve(parser: argparse.ArgumentParser) -> None:
 def _print_result(result, as_json: bool) -> int:
     """Print a result as JSON or as a table; return exit code 0."""
     if as_json:
-        print(json.dumps(result.to_json_dict(), indent=2, allow_nan=False))
+        print(json.dumps(json_clean(result.to_json_dict()), indent=2, allow_nan=False))
     else:
         print(result.table())
     return 0
@@ -294,7 +294,7 @@ def _run_sample(args: argparse.Namespace) -> int:
         plan = SamplePlan.build(args.scene, dists, args.n, args.seed, args.outputs)
         summary = summarize(plan, out=args.out, q=PERCENTILES, **_run_options(args))
     if args.json:
-        print(json.dumps(_summary_json(summary, plan), indent=2, allow_nan=False))
+        print(json.dumps(json_clean(_summary_json(summary, plan)), indent=2, allow_nan=False))
     else:
         _print_summary(summary, plan.units, args.out, seed=plan.entropy)
     return 0

@@ -18,7 +18,7 @@ from typing import Any
 from . import _kernels
 from .batch import run_columns
 from .codes import describe_flags, describe_status
-from .result import UNIT_LABELS, json_number, road_speed_rows, table_cell
+from .result import UNIT_LABELS, json_number, road_speed_rows, table_cell, without_residue
 from .scene import Scene, SceneError, load_scene
 from .single import overflow_error
 
@@ -120,8 +120,6 @@ class Reconstruction:
                 ("PDOF [o'clock]", one.pdof_clock, two.pdof_clock)]
         lines = [f"reconstruction, {self.units} units", "",
                  f"{'':<28}{one.name:>{width}}{two.name:>{width}}"]
-        lines += [f"{label:<28}{table_cell(a):>{width}}{table_cell(b):>{width}}" for label, a, b in rows]
-        lines.append("")
         implied = [("implied restitution e", self.e), ("implied impulse ratio mu", self.mu),
                    ("critical impulse ratio mu_c", self.mu_c),
                    ("implied moment restitution e_m", self.e_m),
@@ -129,6 +127,10 @@ class Reconstruction:
                    (f"  consistency residual [{labels['moment']}]", self.M_residual),
                    (f"energy loss TL {energy}", self.TL), (f"  normal TLn {energy}", self.TLn),
                    (f"  tangential TLt {energy}", self.TLt), (f"  moment TLm {energy}", self.TLm)]
+        clean = without_residue(rows + implied)  # rounding residue of a zero shown as 0
+        rows, implied = clean[:len(rows)], clean[len(rows):]
+        lines += [f"{label:<28}{table_cell(a):>{width}}{table_cell(b):>{width}}" for label, a, b in rows]
+        lines.append("")
         lines += [f"{label:<36}{table_cell(value):>14}" for label, value in implied]
         lines += ["", "warnings:"] + [f"  - {w}" for w in self.warnings] if self.warnings \
             else ["", "warnings: none"]

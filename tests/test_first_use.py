@@ -5,6 +5,8 @@ answer (exit 2, the field named) or the quiet behaviour the issue asks for.
 """
 
 import json
+import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +15,7 @@ import pytest
 import impactsym
 from impactsym.cli import main
 from impactsym.codes import FLAG_E_OUT_OF_RANGE
+from impactsym.result import json_number, without_residue
 from impactsym.scene import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -197,3 +200,47 @@ def test_an_absurd_normal_angle_is_refused_as_an_angle():
                                   "normal_angle": SCENE["impact"]["normal_angle"] + 720}}
     assert impactsym.solve(turned).vehicles[0].velocity == pytest.approx(
         impactsym.solve(SCENE).vehicles[0].velocity, rel=1e-12)
+
+
+# --------------------------------------------------------------------------- 4. -0.0 and residue
+
+def test_json_never_prints_negative_zero():
+    assert json.dumps([json_number(-0.0), json_number(0.0), json_number(-1.5)]) == "[0.0, 0.0, -1.5]"
+    assert json_number(math.nan) is None
+
+
+def _command(path: Path) -> str:
+    """The command an example is written for (by its name's prefix)."""
+    for prefix, command in (("invert_", "invert"), ("reconstruct_", "reconstruct"),
+                            ("crash3_", "crash3")):
+        if path.name.startswith(prefix):
+            return command
+    return "solve"
+
+
+@pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml")),
+                         ids=lambda p: p.name)
+def test_no_example_prints_negative_zero_in_json(path, capsys):
+    # crash3_barrier_si.json printed a -0.0 delta-V component before.
+    code, out, err = run(capsys, _command(path), path, "--json")
+    assert code == 0, err
+    assert not re.search(r"-0\.0\b(?!\d)", out)
+    json.loads(out)
+
+
+def test_tables_show_rounding_residue_as_zero_but_json_keeps_it(capsys):
+    path = EXAMPLES / "reconstruct_two_car_si.json"
+    code, table, _ = run(capsys, "reconstruct", path)
+    assert code == 0 and "e-1" not in table and "e-2" not in table
+    velocity = next(line for line in table.splitlines() if line.startswith("velocity x"))
+    assert velocity.split()[-1] == "0"
+    code, out, _ = run(capsys, "reconstruct", path, "--json")
+    residue = json.loads(out)["vehicles"][1]["velocity"][0]
+    assert 0 < abs(residue) < 1e-12   # the API and JSON keep the computed value
+
+
+def test_residue_is_judged_against_the_scale_of_its_unit():
+    rows = [("v [m/s]", 50.0, 7.3e-16), ("tiny [J]", 1e-15, 2e-15), ("mu", 0.3, -1e-17)]
+    assert without_residue(rows) == [("v [m/s]", 50.0, 0.0), ("tiny [J]", 1e-15, 2e-15),
+                                     ("mu", 0.3, 0.0)]
+    assert without_residue([("v [m/s]", 50.0, 1e-9)]) == [("v [m/s]", 50.0, 1e-9)]
