@@ -10,7 +10,9 @@ unreadable file, a wrong argument) prints one line ``impactsym: error:
 from __future__ import annotations
 
 import argparse
+import io
 import json
+import os
 import sys
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -35,6 +37,7 @@ __all__ = ["main", "build_parser", "Command", "COMMANDS"]
 
 PROG = "impactsym"
 EXIT_BAD_INPUT = 2
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
 
 
 @dataclass(frozen=True)
@@ -54,7 +57,18 @@ class _Parser(argparse.ArgumentParser):
     """An argument parser that raises :class:`UsageError` instead of printing usage and exiting."""
 
     def error(self, message: str):
-        raise UsageError(message)
+        raise UsageError(_once(message))
+
+
+def _once(message: str) -> str:
+    """argparse's ``argument --plot: <reason>`` without the option's name
+    when the reason already starts with it (``--plot out.txt: unknown image
+    type``): the name is said once."""
+    head, sep, reason = message.partition(": ")
+    names = head.removeprefix("argument ").split("/")
+    if sep and head.startswith("argument ") and reason.startswith(tuple(names)):
+        return reason
+    return message
 
 
 def _add_scene(parser: argparse.ArgumentParser) -> None:
@@ -420,16 +434,37 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; return the exit code (0 success, 2 bad input)."""
+    """Run the command line; return the exit code (0 success, 2 bad input,
+    130 interrupted by Ctrl-C; a reader that stops reading, as ``| head``
+    does, ends the command quietly with 1)."""
     try:
         args = build_parser().parse_args(argv)
-        return COMMANDS[args.command].run(args)
+        code = COMMANDS[args.command].run(args)
+        sys.stdout.flush()  # a closed pipe shows here, not at interpreter exit
+        return code
+    except BrokenPipeError:
+        return _reader_gone()
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except (UsageError, SceneError) as exc:
         return _fail(str(exc))
     except OSError as exc:
         return _fail(f"{exc.filename}: {exc.strerror}" if exc.filename else str(exc))
     except SystemExit as exc:
         return exc.code if isinstance(exc.code, int) else 0
+
+
+def _reader_gone() -> int:
+    """stdout's reader has gone (``impactsym solve x.json --json | head -c 10``):
+    say nothing, and point stdout at devnull so that Python's final flush does
+    not fail again (the recipe of Python's signal documentation)."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, io.UnsupportedOperation):
+        pass  # stdout is not a file descriptor (captured in-process): nothing to flush
+    return 1
 
 
 def _fail(reason: str) -> int:

@@ -4,16 +4,20 @@ Every test feeds the careless input a newcomer would and asserts the one-line
 answer (exit 2, the field named) or the quiet behaviour the issue asks for.
 """
 
+import dataclasses
 import json
 import math
+import os
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import impactsym
-from impactsym.cli import main
+from impactsym.cli import COMMANDS, main
 from impactsym.codes import FLAG_E_OUT_OF_RANGE
 from impactsym.result import json_number, without_residue
 from impactsym.scene import load_scene
@@ -244,3 +248,39 @@ def test_residue_is_judged_against_the_scale_of_its_unit():
     assert without_residue(rows) == [("v [m/s]", 50.0, 0.0), ("tiny [J]", 1e-15, 2e-15),
                                      ("mu", 0.3, 0.0)]
     assert without_residue([("v [m/s]", 50.0, 1e-9)]) == [("v [m/s]", 50.0, 1e-9)]
+
+
+# --------------------------------------------------------------------------- 5. the command line
+
+def _cli(*argv) -> list[str]:
+    """The command line of ``impactsym`` in a subprocess of this checkout."""
+    return [sys.executable, "-m", "impactsym", *map(str, argv)]
+
+
+def _env(**extra) -> dict:
+    return {**os.environ, "PYTHONPATH": str(ROOT), **extra}
+
+
+def test_a_plot_error_names_the_option_once(capsys):
+    err = one_line_error(capsys, "solve", EXAMPLES / "two_car_us.json", "--plot", "out.txt")
+    assert err.count("--plot") == 1 and "argument" not in err
+    # Other argparse errors keep their "argument" prefix.
+    assert "argument --chunk-size: invalid int value" in one_line_error(
+        capsys, "sweep", EXAMPLES / "two_car_us.json", "--chunk-size", "x")
+
+
+def test_a_reader_that_goes_away_gets_no_error():
+    process = subprocess.Popen(_cli("solve", EXAMPLES / "two_car_us.json", "--json"),
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=_env())
+    process.stdout.close()  # the reader is gone before the first write: EPIPE for sure
+    err = process.stderr.read()
+    assert process.wait(timeout=60) == 1
+    assert err == b""
+
+
+def test_ctrl_c_is_one_line_and_exit_130(capsys, monkeypatch):
+    def interrupted(args):
+        raise KeyboardInterrupt
+    monkeypatch.setitem(COMMANDS, "solve", dataclasses.replace(COMMANDS["solve"], run=interrupted))
+    code, out, err = run(capsys, "solve", EXAMPLES / "two_car_us.json")
+    assert (code, out, err) == (130, "", "impactsym: interrupted\n")
