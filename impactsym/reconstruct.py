@@ -152,8 +152,26 @@ def reconstruct(scene: Scene | Mapping | str | Path) -> Reconstruction:
     scalars = {k: out[k] for k in ("Pn", "Pt", "M", "M_residual", "e", "mu", "e_m", "mu_c",
                                    "TL", "TLn", "TLt", "TLm")}
     return Reconstruction(units=scene.units, vehicles=vehicles, flags=out["flags"],
-                          warnings=describe_flags(out["flags"]) + list(scene.warnings),
-                          **scalars)
+                          warnings=describe_flags(out["flags"]) + moment_warnings(out["e_m"])
+                          + list(scene.warnings), **scalars)
+
+
+#: The physical range of the moment restitution: e_m is the ratio of the final
+#: to the initial relative yaw rate at the impact, so TLm = (wr² - Wr²)/(2 Σj)
+#: is a loss only when |e_m| <= 1 (the range scenes are warned about too).
+MOMENT_RESTITUTION_RANGE = (-1.0, 1.0)
+
+
+def moment_warnings(e_m: float) -> list[str]:
+    """A warning when the implied moment restitution is outside its physical
+    range (a runtime check of the kernel's output; the kernel has no flag bit
+    for it)."""
+    low, high = MOMENT_RESTITUTION_RANGE
+    if not math.isfinite(e_m) or low <= e_m <= high:
+        return []
+    return [f"the implied moment restitution e_m = {e_m:.6g} is outside [{low:g}, {high:g}]: "
+            "the final relative yaw rate exceeds the initial one, which creates rotational "
+            "energy (TLm < 0); check the yaw rates, headings and impact centre"]
 
 
 def _inputs(scene: Scene) -> dict:

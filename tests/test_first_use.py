@@ -19,6 +19,7 @@ import pytest
 import impactsym
 from impactsym.cli import COMMANDS, main
 from impactsym.codes import FLAG_E_OUT_OF_RANGE
+from impactsym.reconstruct import moment_warnings
 from impactsym.result import json_number, without_residue
 from impactsym.scene import load_scene
 
@@ -284,3 +285,27 @@ def test_ctrl_c_is_one_line_and_exit_130(capsys, monkeypatch):
     monkeypatch.setitem(COMMANDS, "solve", dataclasses.replace(COMMANDS["solve"], run=interrupted))
     code, out, err = run(capsys, "solve", EXAMPLES / "two_car_us.json")
     assert (code, out, err) == (130, "", "impactsym: interrupted\n")
+
+
+# --------------------------------------------------------------------------- 6. reconstruct e_m
+
+def test_reconstruct_warns_when_the_implied_moment_restitution_is_outside_its_range():
+    scene = json.loads((EXAMPLES / "reconstruct_two_car_si.json").read_text())
+    result = impactsym.reconstruct(scene)
+    warned = [w for w in result.warnings if "implied moment restitution" in w]
+    assert (abs(result.e_m) > 1.0) == bool(warned)
+    # Other final yaw rates of vehicle 2: the warning comes exactly when |e_m| > 1.
+    outside = 0
+    for rate in (-8.0, -4.0, -1.791, 0.0, 4.0, 8.0):
+        scene["vehicles"][1]["final_yaw_rate"] = rate
+        result = impactsym.reconstruct(scene)
+        warned = [w for w in result.warnings
+                  if f"e_m = {result.e_m:.6g} is outside [-1, 1]" in w]
+        assert (abs(result.e_m) > 1.0) == bool(warned), rate
+        outside += abs(result.e_m) > 1.0
+    assert 0 < outside < 6
+
+
+def test_moment_warnings_bounds():
+    assert moment_warnings(1.0) == moment_warnings(-1.0) == moment_warnings(math.nan) == []
+    assert len(moment_warnings(1.0 + 1e-9)) == len(moment_warnings(-1.5)) == 1
