@@ -21,6 +21,7 @@ from typing import Callable
 import numpy as np
 
 from ._version import __version__
+from .codes import describe_status
 from .compare import compare
 from .crash3 import crash3
 from .scene import SceneError
@@ -29,8 +30,8 @@ from .plot import add_plot_argument, save_plot
 from .reconstruct import reconstruct
 from .result import UNIT_LABELS, json_clean, json_number, table_cell
 from .single import solve
-from .sweep import (CHUNK_SIZE, PERCENTILES, SUMMARY_COLUMNS, SWEEP_PERCENTILES, GridPlan,
-                    SamplePlan, percentiles, summarize, write_frame)
+from .sweep import (CHUNK_SIZE, PERCENTILES, SWEEP_PERCENTILES, GridPlan, SamplePlan,
+                    percentiles, summarize, summary_columns, write_frame)
 from .sweep import sweep as solve_sweep
 
 __all__ = ["main", "build_parser", "Command", "COMMANDS"]
@@ -189,6 +190,7 @@ def _add_sweep(parser: argparse.ArgumentParser) -> None:
                              "the first varying slowest. Names: kernel inputs (e, mu, e_m, gamma "
                              "[rad], m1, v1x, ...) or normal_angle [deg], restitution, "
                              "impulse_ratio, moment_restitution")
+    parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     _add_run_options(parser)
     parser.add_argument("--plot", metavar="OUT.png",
                         help="also draw the sweep (1 or 2 varied parameters; needs matplotlib)")
@@ -219,6 +221,8 @@ def _parse_vary(text: str):
         if len(parts) != 3 or not parts[2].strip().isdigit() or int(parts[2]) < 1:
             raise UsageError(f"{option}: expected NAME=START:STOP:NUM with NUM a positive integer")
         start, stop = (_number(part, option) for part in parts[:2])
+        if not (np.isfinite(start) and np.isfinite(stop)):
+            raise UsageError(f"{option}: START and STOP must be finite numbers")
         return name, np.linspace(start, stop, int(parts[2]))
     if "," in spec:
         return name, [_grid_value(part.strip(), option) for part in spec.split(",")]
@@ -259,7 +263,10 @@ def _run_sweep(args: argparse.Namespace) -> int:
         else:
             summary = summarize(plan, out=args.out, q=SWEEP_PERCENTILES,
                                        **_run_options(args))
-    _print_summary(summary, plan.units, args.out)
+    if args.json:
+        print(json.dumps(json_clean(_summary_json(summary, plan.units)), indent=2, allow_nan=False))
+    else:
+        _print_summary(summary, plan.units, args.out)
     return 0
 
 
@@ -272,8 +279,7 @@ def _sweep_and_plot(args: argparse.Namespace, values: dict, varied: list, units:
                color=args.color, units=units)
     if args.out:
         write_frame(frame, args.out, tuple(varied))
-    return percentiles(frame, [c for c in SUMMARY_COLUMNS if c in frame],
-                              q=SWEEP_PERCENTILES)
+    return percentiles(frame, summary_columns(args.outputs), q=SWEEP_PERCENTILES)
 
 
 def _add_sample(parser: argparse.ArgumentParser) -> None:
@@ -308,7 +314,8 @@ def _run_sample(args: argparse.Namespace) -> int:
         plan = SamplePlan.build(args.scene, dists, args.n, args.seed, args.outputs)
         summary = summarize(plan, out=args.out, q=PERCENTILES, **_run_options(args))
     if args.json:
-        print(json.dumps(json_clean(_summary_json(summary, plan)), indent=2, allow_nan=False))
+        print(json.dumps(json_clean(_summary_json(summary, plan.units, plan.entropy)), indent=2,
+                         allow_nan=False))
     else:
         _print_summary(summary, plan.units, args.out, seed=plan.entropy)
     return 0
@@ -327,16 +334,25 @@ def _api_errors():
 
 def _unit(column: str, units: str) -> str:
     labels = UNIT_LABELS[units]
-    return labels["energy"] if column.startswith("TL") else labels["velocity"]
+    if column.startswith("TL"):
+        return labels["energy"]
+    return labels["yaw_rate"] if column[0] in "Ww" else labels["velocity"]
 
 
 def _print_summary(summary, units: str, out, seed=None) -> None:
-    """Counts, then one line per summarised output with its percentiles."""
+    """Counts, why rows were not solved, then one line per summarised output
+    with its percentiles (none when no row was solved: there is nothing to
+    summarise)."""
     counts = summary.attrs["counts"]
     if out:
         print(f"wrote {counts['rows']} rows to {out}")
     print(f"rows {counts['rows']}: solved {counts['solved']}, flagged {counts['flagged']}, "
           f"not solved {counts['not_solved']}" + (f"; seed {seed}" if seed is not None else ""))
+    for status, rows in counts.get("not_solved_by_status", {}).items():
+        print(f"  not solved, status {status}: {rows} rows: {describe_status(status)}")
+    if counts["solved"] == 0 and counts["rows"]:
+        print("no row was solved: no statistics (the reasons are above)")
+        return
     if summary.empty:
         return
     heads = [_SUMMARY_LABELS.get(label, label) for label in summary.columns]
@@ -346,12 +362,17 @@ def _print_summary(summary, units: str, out, seed=None) -> None:
         print(f"{label:<14}" + "".join(f"{table_cell(value):>14}" for value in row))
 
 
-def _summary_json(summary, plan) -> dict:
-    """The sample summary as a JSON object (percentile keys are the q values)."""
+def _summary_json(summary, units: str, seed=None) -> dict:
+    """The sweep or sample summary as a JSON object (percentile keys are the
+    q values; ``not_solved_by_status`` maps status codes to row counts; a
+    sample also gives its ``seed``)."""
+    counts = dict(summary.attrs["counts"])
+    counts["not_solved_by_status"] = {str(code): rows for code, rows
+                                      in counts.get("not_solved_by_status", {}).items()}
     return {
-        "units": plan.units,
-        "seed": plan.entropy,
-        **summary.attrs["counts"],
+        "units": units,
+        **({"seed": seed} if seed is not None else {}),
+        **counts,
         "percentiles": {column: {label[1:]: json_number(float(value)) for label, value in row.items()}
                         for column, row in summary.iterrows()},
     }

@@ -49,7 +49,7 @@ from ._util import CHUNK_SIZE, require, spans
 from .dask_engine import map_chunks
 from .scene import show_value
 
-__all__ = ["sweep", "sample", "percentiles", "GridPlan", "SamplePlan", "collect", "summarize",
+__all__ = ["sweep", "sample", "percentiles", "summary_columns", "GridPlan", "SamplePlan", "collect", "summarize",
            "write_frame",
            "CHUNK_SIZE", "BLOCK", "DISTRIBUTIONS", "PERCENTILES", "SWEEP_PERCENTILES"]
 
@@ -90,7 +90,7 @@ def sweep(scene, *, outputs=None, engine: str = "local", chunk_size: int = CHUNK
     column is text there) the rows are written chunk by chunk, memory stays
     bounded by ``chunk_size``, and the return value is the summary
     ``percentiles(rows, q=(0, 50, 100))`` (minimum, median, maximum of ``dV1
-    dV2 TL``, those the outputs include), exact: the summarised values of
+    dV2 TL``, those the outputs include: `summary_columns`), exact: the summarised values of
     solved rows spill to a temporary file (8 bytes each), not to memory.
 
     ``engine="dask"`` runs the chunks as dask tasks on the active
@@ -134,7 +134,7 @@ def sample(scene, dists: Mapping, n: int, *, seed=None, outputs=None, engine: st
     outputs, ``status``, ``flags``; see `sweep`). With ``out`` (``.parquet`` or
     ``.csv``) the rows go to the file chunk by chunk, memory stays bounded by
     ``chunk_size`` as for `sweep`, and the return value is the exact summary
-    ``percentiles(rows)`` (``dV1 dV2 TL``, those the outputs include, at
+    ``percentiles(rows)`` (`summary_columns`: ``dV1 dV2 TL`` or the velocities, at
     5, 25, 50, 75, 95 %), with ``attrs["seed"]`` too.
     """
     plan = SamplePlan.build(scene, dists, n, seed, outputs)
@@ -145,6 +145,14 @@ def sample(scene, dists: Mapping, n: int, *, seed=None, outputs=None, engine: st
         result = collect(plan, engine=engine, chunk_size=chunk_size, progress=progress)
     result.attrs["seed"] = plan.entropy
     return result
+
+
+def summary_columns(outputs) -> list[str]:
+    """The outputs a summary reports: those of `SUMMARY_COLUMNS` that
+    ``outputs`` (a `solve_batch` tier or list) includes, or, when it includes
+    none of them (``"velocities"``), every output it has."""
+    names = check_outputs(outputs)
+    return [name for name in SUMMARY_COLUMNS if name in names] or list(names)
 
 
 def percentiles(df, columns=SUMMARY_COLUMNS, q=PERCENTILES):
@@ -193,10 +201,11 @@ def summarize(plan, *, out=None, q=PERCENTILES, engine: str = "local", chunk_siz
     path, or None for no file) and return ``percentiles`` of the rows for the
     default summary columns the outputs include, with bounded memory: the
     summarised values of solved rows spill to a temporary file (8 bytes per
-    value) and the percentiles are selected exactly from it."""
+    value) and the percentiles are selected exactly from it. The columns are
+    `summary_columns` of the plan's outputs."""
     pd = require("pandas", extra="sweep", what="streaming")
     q = check_q(q)
-    columns = [name for name in SUMMARY_COLUMNS if name in check_outputs(plan.outputs)]
+    columns = summary_columns(plan.outputs)
     frames = _frames(plan, engine, chunk_size)
     writer = sink(out, plan.repeated)
     frames = _with_progress(frames, plan.rows, progress)

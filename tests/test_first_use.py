@@ -309,3 +309,67 @@ def test_reconstruct_warns_when_the_implied_moment_restitution_is_outside_its_ra
 def test_moment_warnings_bounds():
     assert moment_warnings(1.0) == moment_warnings(-1.0) == moment_warnings(math.nan) == []
     assert len(moment_warnings(1.0 + 1e-9)) == len(moment_warnings(-1.5)) == 1
+
+
+# --------------------------------------------------------------------------- 7. sweeps, samples
+
+US_SCENE = EXAMPLES / "two_car_us.json"
+
+
+def test_sweep_counts_rows_not_solved_by_status(capsys):
+    code, out, err = run(capsys, "sweep", US_SCENE, "--vary", "m1=-1:100:3", "--no-progress")
+    assert (code, err) == (0, "")
+    assert "not solved 1" in out
+    assert f"  not solved, status 2: 1 rows: {impactsym.describe_status(2)}" in out.splitlines()
+
+
+def test_sweep_with_an_infinite_range_is_one_line_error(capsys):
+    err = one_line_error(capsys, "sweep", US_SCENE, "--vary", "e=0:inf:3")
+    assert "--vary e=0:inf:3: START and STOP must be finite" in err
+
+
+def test_a_sweep_where_no_row_solves_says_so_without_nan_statistics(capsys):
+    code, out, err = run(capsys, "sweep", US_SCENE, "--vary", "m1=-1:-2:3", "--no-progress")
+    assert (code, err) == (0, "")
+    assert "nan" not in out.lower()
+    assert "no row was solved" in out and "status 2: 3 rows" in out
+
+
+def test_sweep_json(capsys):
+    code, out, err = run(capsys, "sweep", US_SCENE, "--vary", "m1=-1:100:3", "--json",
+                         "--no-progress")
+    assert (code, err) == (0, "")
+    data = json.loads(out)
+    assert data["units"] == "US" and "seed" not in data
+    assert (data["rows"], data["solved"], data["not_solved"]) == (3, 2, 1)
+    assert data["not_solved_by_status"] == {"2": 1}
+    frame = impactsym.sweep(US_SCENE, m1=np.linspace(-1, 100, 3))
+    assert data["percentiles"]["TL"]["100"] == frame.loc[frame["status"] == 0, "TL"].max()
+    code, out, _ = run(capsys, "sweep", US_SCENE, "--vary", "m1=-1:-2:2", "--json", "--no-progress")
+    assert json.loads(out)["percentiles"]["TL"] == {"0": None, "50": None, "100": None}
+
+
+def test_sample_of_velocities_prints_a_table(capsys):
+    code, out, err = run(capsys, "sample", US_SCENE, "--dist", "e=uniform:0:0.3", "-n", "200",
+                         "--seed", "3", "--outputs", "velocities", "--no-progress")
+    assert (code, err) == (0, "")
+    rows = {line.split()[0]: line.split() for line in out.splitlines()[2:]}
+    assert set(rows) == {"V1x", "V1y", "W1", "V2x", "V2y", "W2"}
+    assert rows["W1"][1] == "[rad/s]" and rows["V1x"][1] == "[ft/s]"
+    frame = impactsym.sample(US_SCENE, {"e": ("uniform", 0, 0.3)}, 200, seed=3,
+                             outputs="velocities")
+    assert float(rows["V2y"][4]) == pytest.approx(np.percentile(frame["V2y"], 50), rel=1e-5)
+
+
+@pytest.mark.parametrize("name", ["models_two_car_us.json", "two_car_us.json"])
+def test_compare_markdown_has_the_warnings_and_the_skipped_models(name, capsys):
+    result = impactsym.compare(EXAMPLES / name)
+    code, text, _ = run(capsys, "compare", EXAMPLES / name, "--markdown")
+    assert code == 0
+    warnings = [(row.model, w) for row in result.rows for w in row.warnings]
+    assert warnings
+    for model, warning in warnings:
+        assert f"- `{model}`: {warning}" in text
+    for skipped, reason in result.skipped.items():
+        assert f"- skipped `{skipped}`: {reason}" in text
+    assert bool(result.skipped) == (name == "two_car_us.json")  # both cases are met
