@@ -13,7 +13,9 @@ import argparse
 import io
 import json
 import os
+import signal
 import sys
+import threading
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Callable
@@ -39,6 +41,7 @@ __all__ = ["main", "build_parser", "Command", "COMMANDS"]
 PROG = "impactsym"
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
+EXIT_TERMINATED = 143  # 128 + SIGTERM
 
 
 @dataclass(frozen=True)
@@ -459,21 +462,50 @@ def main(argv: list[str] | None = None) -> int:
     130 interrupted by Ctrl-C; a reader that stops reading, as ``| head``
     does, ends the command quietly with 1)."""
     try:
-        args = build_parser().parse_args(argv)
-        code = COMMANDS[args.command].run(args)
-        sys.stdout.flush()  # a closed pipe shows here, not at interpreter exit
-        return code
+        with _terminate_as_exit():
+            args = build_parser().parse_args(argv)
+            code = COMMANDS[args.command].run(args)
+            sys.stdout.flush()  # a closed pipe shows here, not at interpreter exit
+            return code
     except BrokenPipeError:
         return _reader_gone()
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except _Terminated:
+        print(f"{PROG}: terminated", file=sys.stderr)
+        return EXIT_TERMINATED
     except (UsageError, SceneError) as exc:
         return _fail(str(exc))
     except OSError as exc:
         return _fail(f"{exc.filename}: {exc.strerror}" if exc.filename else str(exc))
     except SystemExit as exc:
         return exc.code if isinstance(exc.code, int) else 0
+
+
+class _Terminated(SystemExit):
+    """SIGTERM, raised as an exit so that every ``finally`` and ``with`` on
+    the way out runs (a sweep's spill folder is removed, a partial output
+    file deleted) instead of the process dying where it stands."""
+
+
+def _raise_terminated(signum, frame):
+    raise _Terminated(EXIT_TERMINATED)
+
+
+@contextmanager
+def _terminate_as_exit():
+    """SIGTERM raises :class:`_Terminated` while the command runs (the main
+    thread only: a signal handler cannot be set elsewhere); the previous
+    handler is restored after."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def _reader_gone() -> int:

@@ -8,6 +8,13 @@ units, ``normal_angle`` in degrees), then the outputs of `solve_batch`, then
 generated kernels through `solve_batch`; this module only builds inputs,
 streams results and summarises them.
 
+Before any work, a run that cannot fit is refused with a one-line ValueError
+(`impactsym._resources`): rows held in memory beyond half of the available
+memory (use ``out=``), or percentile spill files beyond the free temporary
+space. The spill files live in a temporary folder removed on every way out
+(the end, an error, Ctrl-C; the command line turns SIGTERM into an exit so
+they are removed then too).
+
 Work runs in chunks of ``chunk_size`` rows: a chunk builds its own inputs from
 its (start, stop) row indices (grid rows by `numpy.unravel_index`, sample rows
 from fixed random blocks), so neither the grid nor the sample is ever held as
@@ -44,6 +51,7 @@ import numpy as np
 
 from ._plans import BLOCK, DISTRIBUTIONS, GridPlan, SamplePlan, check_outputs, frame_of, is_integer
 from ._quantiles import InMemory, StreamSummary, check_q, counts, summary_frame
+from ._resources import check_disk, check_memory
 from ._sinks import sink, write_frame, writing
 from ._util import CHUNK_SIZE, require, spans
 from .dask_engine import map_chunks
@@ -191,6 +199,7 @@ def _frames(plan, engine: str, chunk_size: int) -> Iterator:
 def collect(plan, *, engine: str = "local", chunk_size: int = CHUNK_SIZE, progress=None):
     """Every row of ``plan`` in one DataFrame (index 0..rows-1)."""
     pd = require("pandas", extra="sweep", what="collect")
+    check_memory(plan.rows, _values_per_row(plan), _kind(plan))
     frames = list(_with_progress(_frames(plan, engine, chunk_size), plan.rows, progress))
     return frames[0] if len(frames) == 1 else pd.concat(frames)
 
@@ -206,6 +215,7 @@ def summarize(plan, *, out=None, q=PERCENTILES, engine: str = "local", chunk_siz
     pd = require("pandas", extra="sweep", what="streaming")
     q = check_q(q)
     columns = summary_columns(plan.outputs)
+    check_disk(plan.rows, len(columns), _kind(plan))
     frames = _frames(plan, engine, chunk_size)
     writer = sink(out, plan.repeated)
     frames = _with_progress(frames, plan.rows, progress)
@@ -219,6 +229,16 @@ def summarize(plan, *, out=None, q=PERCENTILES, engine: str = "local", chunk_siz
         finally:
             summary.close()
         return summary_frame(pd, summary.stats, q, summary.counts)
+
+
+def _kind(plan) -> str:
+    return "sweep" if isinstance(plan, GridPlan) else "sample"
+
+
+def _values_per_row(plan) -> int:
+    """8-byte values of one row of a plan's frame: the varied inputs, the
+    outputs, and status and flags (4 bytes each)."""
+    return len(plan.names) + len(check_outputs(plan.outputs)) + 1
 
 
 def _with_progress(frames: Iterator, rows: int, progress) -> Iterator:

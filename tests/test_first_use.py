@@ -9,8 +9,10 @@ import json
 import math
 import os
 import re
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -373,3 +375,60 @@ def test_compare_markdown_has_the_warnings_and_the_skipped_models(name, capsys):
     for skipped, reason in result.skipped.items():
         assert f"- skipped `{skipped}`: {reason}" in text
     assert bool(result.skipped) == (name == "two_car_us.json")  # both cases are met
+
+
+# --------------------------------------------------------------------------- 8. too large, interrupts
+
+HUGE = ["--vary", "e=0:1:1000000", "--vary", "mu=0:0.5:1000000"]   # 1e12 rows: never allocated
+
+
+def test_a_grid_too_large_for_the_temporary_disk_is_refused(capsys):
+    err = one_line_error(capsys, "sweep", US_SCENE, *HUGE, "--no-progress")
+    assert "1,000,000,000,000 rows need about" in err and "temporary space" in err
+    assert "fewer points" in err
+
+
+def test_a_grid_too_large_for_memory_is_refused_before_any_work(capsys):
+    err = one_line_error(capsys, "sweep", US_SCENE, *HUGE, "--plot", "never.png")
+    assert "in memory" in err and "-o rows.parquet" in err
+    with pytest.raises(ValueError, match=r"^sweep: 1,000,000,000,000 rows need about .* in memory"):
+        impactsym.sweep(US_SCENE, e=np.linspace(0, 1, 10**6), mu=np.linspace(0, 0.5, 10**6))
+    with pytest.raises(ValueError, match=r"^sample: 1,000,000,000,000 rows need about"):
+        impactsym.sample(US_SCENE, {"e": ("uniform", 0, 1)}, 10**12, seed=1)
+
+
+def test_the_limits_follow_what_the_machine_has(monkeypatch, tmp_path):
+    """The refusal is a comparison with the memory and disk the machine reports."""
+    from impactsym import _resources
+
+    monkeypatch.setattr(_resources, "available_memory", lambda: 10**6)
+    with pytest.raises(ValueError, match="in memory"):
+        impactsym.sweep(US_SCENE, e=np.linspace(0, 1, 10**4))
+    monkeypatch.setattr(_resources, "available_memory", lambda: 10**12)
+    assert len(impactsym.sweep(US_SCENE, e=np.linspace(0, 1, 10**4))) == 10**4
+
+
+@pytest.mark.parametrize("signal_name, code, said", [("SIGTERM", 143, "terminated"),
+                                                     ("SIGINT", 130, "interrupted")])
+def test_an_interrupted_sweep_leaves_no_spill_file_and_no_traceback(tmp_path, signal_name, code,
+                                                                    said):
+    temp = tmp_path / "tmp"
+    temp.mkdir()
+    # 1e6 rows in chunks of 500: about 20 s of work, interrupted once it spills.
+    process = subprocess.Popen(
+        _cli("sweep", US_SCENE, "--vary", "e=0:1:1000", "--vary", "mu=0:0.5:1000",
+             "--chunk-size", "500", "--no-progress"),
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=_env(TMPDIR=str(temp)))
+    try:
+        deadline = time.monotonic() + 60
+        while not any(temp.iterdir()) and time.monotonic() < deadline and process.poll() is None:
+            time.sleep(0.05)
+        assert any(temp.iterdir()), "the sweep never spilled"
+        time.sleep(0.5)
+        process.send_signal(getattr(signal, signal_name))
+        out, err = process.communicate(timeout=60)
+    finally:
+        process.kill()
+    assert process.returncode == code
+    assert err.decode() == f"impactsym: {said}\n"
+    assert list(temp.iterdir()) == []
