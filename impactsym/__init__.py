@@ -16,7 +16,7 @@ on vehicle 1; lower case initial, upper case final).
 """
 
 from . import plot
-from ._version import __version__
+from ._version import __version__ as __version__
 from .batch import solve_batch
 from .codes import FLAG_MESSAGES, STATUS_MESSAGES, describe_flags, describe_status
 from .compare import compare
@@ -34,5 +34,5 @@ __all__ = [
     "FLAG_MESSAGES", "MODELS", "STATUS_MESSAGES", "Impact", "Result", "Scene", "SceneError",
     "Vehicle", "compare", "crash3", "delta_v_from_energy", "describe_flags", "describe_status",
     "explore", "invert", "invert_batch", "load_scene", "percentiles", "plot", "reconstruct",
-    "reconstruct_batch", "sample", "solve", "solve_batch", "sweep", "__version__",
+    "reconstruct_batch", "sample", "solve", "solve_batch", "sweep",
 ]
