@@ -47,9 +47,11 @@ def one_line_error(capsys, *argv) -> str:
 
 # --------------------------------------------------------------------------- 1. scene files
 
-def test_deeply_nested_json_is_one_line(tmp_path, capsys):
-    path = tmp_path / "deep.json"
-    path.write_text("[" * 100_000)
+@pytest.mark.parametrize("name, text", [("deep.json", "[" * 100_000),
+                                        ("deep.toml", "a = " + "[" * 100_000)])
+def test_deeply_nested_file_is_one_line(tmp_path, capsys, name, text):
+    path = tmp_path / name
+    path.write_text(text)
     assert "nested too deeply" in one_line_error(capsys, "solve", path)
 
 
