@@ -43,14 +43,14 @@ def check_columns(columns, known: tuple[str, ...], model: str,
                   everywhere: tuple[str, ...] = ()) -> None:
     """ValueError unless ``columns`` is a mapping (or DataFrame) of columns
     that the kernel reads (``known``): a name in ``everywhere`` (read by other
-    models) is "not used by the ``model`` model", any other is unknown, with
+    models) is "given but not used by ``model``" (``"the particle model"``), any other is unknown, with
     the nearest known name, as an unknown key of a scene file is."""
     require_mapping(columns)
     for name in columns:
         if name in known:
             continue
         if name in everywhere:
-            raise ValueError(f"{name}: given but not used by the {model} model "
+            raise ValueError(f"{name}: given but not used by {model} "
                              f"(its columns: {' '.join(known)})")
         raise ValueError(f"{name}: {unknown_key(str(name), known, 'column', _SCENE_WORDS)}")
 
@@ -120,7 +120,8 @@ def _as_column(columns, name: str):
 def run_columns(ks: _kernels.KernelSet, columns, outputs, model: str,
                 everywhere: tuple[str, ...] = ()):
     """Validate `columns` for kernel `ks` (`check_columns`: `model` names it
-    in messages, `everywhere` are the columns of its other models), run it,
+    in messages, ``"the particle model"``; `everywhere` are the columns of
+    its other models), run it,
     and return `outputs` plus `status` and `flags` as the same kind of
     mapping (dict or DataFrame)."""
     check_columns(columns, ks.inputs, model, everywhere)
@@ -260,7 +261,8 @@ def _check_forward_columns(columns, models) -> None:
     names = [models] if isinstance(models, str) else sorted(set(models.tolist()))
     everywhere = tuple(dict.fromkeys(c for family in _kernels.MODELS for c in _forward_inputs(family)))
     known = tuple(dict.fromkeys(c for name in names for c in _forward_inputs(name))) or everywhere
-    check_columns(columns, known, names[0] if len(names) == 1 else "batch's", everywhere)
+    label = f"the {names[0]} model" if len(names) == 1 else f"the models {', '.join(names)}"
+    check_columns(columns, known, label, everywhere)
 
 
 def _row_models(columns, model):

@@ -41,7 +41,7 @@ def invert_batch(columns, model: str = "rigid"):
     everywhere = tuple(c for name in _kernels.INVERSE_MODELS
                        for c in _kernels.inverse_kernel_for(name).inputs)
     return run_columns(_kernels.inverse_kernel_for(model), columns, _kernels.INVERSE_OUTPUTS,
-                       model, everywhere)
+                       f"the {model} model", everywhere)
 
 
 def invert(scene: Scene | Mapping | str | Path) -> Result:

@@ -37,7 +37,7 @@ def reconstruct_batch(columns):
     TL TLn TLt TLm pdof1 pdof2`` (PDOF in radians, counter-clockwise from the
     heading, of the direction the impulse comes from) plus status and flags.
     """
-    return run_columns(_kernels.RECONSTRUCT, columns, OUTPUTS, "reconstruction")
+    return run_columns(_kernels.RECONSTRUCT, columns, OUTPUTS, "the reconstruction")
 
 
 @dataclass(frozen=True)
