@@ -16,6 +16,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 import impactsym
@@ -102,9 +103,14 @@ PARTICLE = {k: RIGID[k] for k in ("m1", "m2", "v1x", "v1y", "v2x", "v2y", "gamma
 
 
 def test_empty_columns_give_an_empty_result_with_every_column():
-    out = impactsym.solve_batch({k: np.array([]) for k in RIGID})
-    assert set(out) == {*impactsym.solve_batch(RIGID), "status", "flags"}
-    assert all(len(v) == 0 for v in out.values())
+    empty = {k: np.array([]) for k in RIGID}
+    every = set(impactsym.solve_batch(RIGID))
+    for out in (impactsym.solve_batch(empty), impactsym.solve_batch(empty, model=[]),
+                impactsym.solve_batch(pd.DataFrame(empty))):
+        assert set(out) == every and all(len(out[k]) == 0 for k in every)
+    finals = {("V" + k[1:]) if k[0] == "v" else ("W" + k[1:]) if k[0] == "w" else k: v
+              for k, v in empty.items()}
+    assert all(len(v) == 0 for v in impactsym.invert_batch(finals).values())
 
 
 def test_unknown_column_is_refused_with_the_nearest_name():
