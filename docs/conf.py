@@ -11,13 +11,9 @@ the glob in index.md without an edit here.
 """
 
 import re
+import runpy
 import sys
 from pathlib import Path
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:
-    import tomli as tomllib
 
 ROOT = Path(__file__).resolve().parents[1]
 # autodoc imports the package from this checkout, never from an installed copy.
@@ -25,7 +21,8 @@ sys.path.insert(0, str(ROOT))
 
 project = "impactsym"
 author = "impactsym contributors"
-release = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]["version"]
+# The version is written once, in impactsym/_version.py (pyproject.toml reads it too).
+release = runpy.run_path(str(ROOT / "impactsym" / "_version.py"))["__version__"]
 version = release
 
 extensions = [

@@ -17,6 +17,7 @@ on vehicle 1; lower case initial, upper case final).
 """
 
 from . import plot
+from ._version import __version__ as __version__
 from .batch import solve_batch
 from .codes import FLAG_MESSAGES, STATUS_MESSAGES, describe_flags, describe_status
 from .compare import compare
@@ -30,8 +31,6 @@ from .result import Result
 from .scene import MODELS, Impact, Scene, SceneError, Vehicle, load_scene
 from .single import solve
 from .sweep import percentiles, sample, sweep
-
-__version__ = "0.1.0"
 
 __all__ = [
     "FLAG_MESSAGES", "MODELS", "STATUS_MESSAGES", "Impact", "Result", "Scene", "SceneError",

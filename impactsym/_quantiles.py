@@ -17,7 +17,7 @@ import numpy as np
 
 from .scene import show_value
 
-__all__ = ["check_q", "counts", "summary_frame", "InMemory", "StreamSummary", "OrderStatistics"]
+__all__ = ["add_counts", "check_q", "counts", "summary_frame", "InMemory", "StreamSummary", "OrderStatistics"]
 
 
 def check_q(q) -> tuple[float, ...]:
@@ -30,10 +30,27 @@ def check_q(q) -> tuple[float, ...]:
     return values
 
 
-def counts(status: np.ndarray, flags: np.ndarray) -> dict[str, int]:
+def counts(status: np.ndarray, flags: np.ndarray) -> dict:
+    """Row counts: ``rows``, ``solved``, ``not_solved``, ``flagged`` and
+    ``not_solved_by_status`` (status code -> rows: why rows were not solved,
+    `impactsym.codes.describe_status`)."""
     solved = int(np.count_nonzero(status == 0))
+    codes, numbers = np.unique(status[status != 0], return_counts=True)
     return {"rows": int(status.size), "solved": solved, "not_solved": int(status.size) - solved,
-            "flagged": int(np.count_nonzero(flags))}
+            "flagged": int(np.count_nonzero(flags)),
+            "not_solved_by_status": {int(c): int(k) for c, k in zip(codes, numbers)}}
+
+
+def add_counts(total: dict, more: dict) -> None:
+    """Add the `counts` of more rows to ``total`` (in place)."""
+    for key, value in more.items():
+        if isinstance(value, dict):
+            by = total.setdefault(key, {})
+            for code, number in value.items():
+                by[code] = by.get(code, 0) + number
+            total[key] = dict(sorted(by.items()))
+        else:
+            total[key] = total.get(key, 0) + value
 
 
 def _label(q: float) -> str:
@@ -46,7 +63,8 @@ def summary_frame(pd, stats: Mapping, q: tuple[float, ...], counts: dict):
     rows = {name: _interpolate(stat, q) for name, stat in stats.items()}
     frame = (pd.DataFrame.from_dict(rows, orient="index", columns=labels) if rows
              else pd.DataFrame(columns=labels, dtype=np.float64))
-    frame.attrs["counts"] = dict(counts)
+    frame.attrs["counts"] = {key: dict(value) if isinstance(value, dict) else value
+                             for key, value in counts.items()}
     return frame
 
 
@@ -87,13 +105,13 @@ class StreamSummary:
     files in ``directory``."""
 
     def __init__(self, columns: list[str], directory: Path):
-        self.counts = {"rows": 0, "solved": 0, "not_solved": 0, "flagged": 0}
+        self.counts = {"rows": 0, "solved": 0, "not_solved": 0, "flagged": 0,
+                       "not_solved_by_status": {}}
         self.stats = {name: OrderStatistics(directory / f"{i}.f8") for i, name in enumerate(columns)}
 
     def add(self, frame) -> None:
         status = frame["status"].to_numpy()
-        for key, value in counts(status, frame["flags"].to_numpy()).items():
-            self.counts[key] += value
+        add_counts(self.counts, counts(status, frame["flags"].to_numpy()))
         solved = status == 0
         for name, stat in self.stats.items():
             stat.add(frame[name].to_numpy()[solved])

@@ -1,10 +1,17 @@
 """`solve_batch`: many scenes at once through the generated numba drivers.
 
-Columns follow conventions.md (struct of arrays, float64, angles in radians).
-A column may also be a scalar: the same value for every row, passed to the
-kernel as a scalar (never broadcast), so a constant angle costs one cos/sin.
-A bad row never stops the batch: it gets a non-zero `status` and NaN outputs.
-A bad *column* (missing, wrong length, not numeric) is a whole-batch error.
+Columns follow conventions.md (struct of arrays, float64, angles in RADIANS:
+a heading or normal angle given in degrees by mistake gives a wrong result and
+no flag). A column may also be a scalar: the same value for every row, passed
+to the kernel as a scalar (never broadcast), so a constant angle costs one
+cos/sin. A bad row never stops the batch: it gets a non-zero `status` and NaN
+outputs. A bad *column* is a whole-batch one-line ValueError naming it, as
+strict as a scene file: missing, of another length, unknown (with the nearest
+name, ``restitusion: unknown column; did you mean "e" (restitution)?``), not
+read by the model (``I1`` for particles), or not numbers (bool, text, None, a
+structured array). A forward or inverse row whose given restitution e is
+outside [0, 1] is solved (as a scene is, with a warning) and marked with the
+flag `codes.FLAG_E_OUT_OF_RANGE`.
 
 Dispatch is per whole array, never per row in Python: the rows of a batch are
 grouped by (model, critical impulse ratio), each group runs the most
@@ -15,12 +22,81 @@ results come back in the original row order.
 
 from __future__ import annotations
 
+import numbers
+from collections.abc import Mapping
+
 import numpy as np
 
 from . import _kernels
 from ._util import CHUNK_SIZE, is_dataframe, row_count, spans
+from .casefile import unknown_key
+from .codes import FLAG_E_OUT_OF_RANGE
 from .dask_engine import map_chunks
 from .scene import CRITICAL
+
+#: Scene-file words for batch columns: a near miss of one suggests its column.
+_SCENE_WORDS = {"restitution": "e", "impulse_ratio": "mu", "moment_restitution": "e_m",
+                "normal_angle": "gamma", "mass": "m1", "yaw_inertia": "I1", "yaw_rate": "w1"}
+
+
+def check_columns(columns, known: tuple[str, ...], model: str,
+                  everywhere: tuple[str, ...] = ()) -> None:
+    """ValueError unless ``columns`` is a mapping (or DataFrame) of columns
+    that the kernel reads (``known``): a name in ``everywhere`` (read by other
+    models) is "given but not used by ``model``" (``"the particle model"``), any other is unknown, with
+    the nearest known name, as an unknown key of a scene file is."""
+    require_mapping(columns)
+    for name in columns:
+        if name in known:
+            continue
+        if name in everywhere:
+            raise ValueError(f"{name}: given but not used by {model} "
+                             f"(its columns: {' '.join(known)})")
+        raise ValueError(f"{name}: {unknown_key(str(name), known, 'column', _SCENE_WORDS)}")
+
+
+def require_mapping(columns) -> None:
+    """ValueError unless ``columns`` is a mapping or a DataFrame of columns."""
+    if not (isinstance(columns, Mapping) or is_dataframe(columns)):
+        raise ValueError(_not_a_mapping(columns))
+
+
+def _not_a_mapping(columns) -> str:
+    """Why ``columns`` is not a batch, and what to pass instead."""
+    if isinstance(columns, np.ndarray) and columns.dtype.names:
+        return ("columns: a structured array; pass a dict of its fields, "
+                "{name: a[name] for name in a.dtype.names}, or a pandas DataFrame")
+    if isinstance(columns, (list, tuple)):
+        return ("columns: a list (one scene per item?); pass a dict of columns "
+                "(name -> array) or pandas.DataFrame(rows)")
+    return ("columns: must be a dict of columns (name -> array) or a DataFrame, "
+            f"got {type(columns).__name__}")
+
+
+_ALL_NUMBERS = object()  # no bad element found (None itself is a bad one)
+
+
+def _check_numbers(arr: np.ndarray, name: str) -> None:
+    """ValueError unless ``arr`` holds real numbers: a scene file refuses
+    true/false, text and null for a number, and so does a batch (NumPy would
+    read True as 1.0 and "0.3" as 0.3)."""
+    kind = arr.dtype.kind
+    if arr.dtype.names:
+        raise ValueError(f"{name}: a structured array, not a numeric column "
+                         f"(fields {', '.join(arr.dtype.names)}; pass one field)")
+    if kind in "fiu":
+        return
+    if kind == "O":
+        not_numbers = (v for v in arr.flat
+                       if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real))
+        bad = next(not_numbers, _ALL_NUMBERS)
+        if bad is _ALL_NUMBERS:
+            return
+        shown = repr(bad) if len(repr(bad)) <= 40 else repr(bad)[:37] + "..."
+        raise ValueError(f"{name}: must be numbers, got {shown} ({type(bad).__name__})")
+    what = {"b": "true/false (bool)", "U": "text", "S": "bytes"}.get(kind, f"dtype {arr.dtype}")
+    raise ValueError(f"{name}: must be numbers, got {what}; a batch, like a scene file, "
+                     "reads numbers only (no units, no booleans)")
 
 
 def _as_column(columns, name: str):
@@ -29,9 +105,11 @@ def _as_column(columns, name: str):
     if name not in columns:
         raise ValueError(f"{name}: missing column")
     try:
-        arr = np.asarray(columns[name], dtype=np.float64)
+        arr = np.asarray(columns[name])
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{name}: not a numeric column ({exc})") from None
+    _check_numbers(arr, name)
+    arr = arr.astype(np.float64, copy=False)
     if arr.ndim == 0:
         return float(arr)
     if arr.ndim > 1:
@@ -39,11 +117,15 @@ def _as_column(columns, name: str):
     return arr
 
 
-def run_columns(ks: _kernels.KernelSet, columns, outputs, placeholders=()):
-    """Validate `columns` for kernel `ks`, run it, and return `outputs` plus
-    `status` and `flags` as the same kind of mapping (dict or DataFrame).
-    Inputs named in `placeholders` are not read (the kernel ignores them)."""
-    return _like(columns, _run(ks, columns, outputs, placeholders))
+def run_columns(ks: _kernels.KernelSet, columns, outputs, model: str,
+                everywhere: tuple[str, ...] = ()):
+    """Validate `columns` for kernel `ks` (`check_columns`: `model` names it
+    in messages, ``"the particle model"``; `everywhere` are the columns of
+    its other models), run it,
+    and return `outputs` plus `status` and `flags` as the same kind of
+    mapping (dict or DataFrame)."""
+    check_columns(columns, ks.inputs, model, everywhere)
+    return _like(columns, _run(ks, columns, outputs, ()))
 
 
 def _run(ks: _kernels.KernelSet, columns, outputs, placeholders) -> dict:
@@ -52,7 +134,21 @@ def _run(ks: _kernels.KernelSet, columns, outputs, placeholders) -> dict:
     n = row_count(columns, names)
     inputs = [0.0 if name in placeholders else _as_column(columns, name)
               for name in ks.inputs]
-    return _collect(ks, *_kernels.run_batch(ks, inputs, n), outputs, n)
+    outs, status, flags = _kernels.run_batch(ks, inputs, n)
+    if "e" in names:
+        _flag_restitution(inputs[ks.inputs.index("e")], status, flags)
+    return _collect(ks, outs, status, flags, outputs, n)
+
+
+def _flag_restitution(e, status: np.ndarray, flags: np.ndarray) -> None:
+    """Mark the solved rows whose given restitution is outside [0, 1] with
+    FLAG_E_OUT_OF_RANGE (in place): e < 0 leaves the vehicles moving into
+    each other after the impact, e > 1 creates normal energy. The kernel
+    solves them (its equations hold for any e) and the scene path warns; a
+    batch row has no warnings, so it carries the flag. NaN e is status 1."""
+    outside = (np.asarray(e) < 0.0) | (np.asarray(e) > 1.0)
+    if np.any(outside):
+        flags |= np.where(outside & (status == 0), FLAG_E_OUT_OF_RANGE, 0).astype(flags.dtype)
 
 
 def _collect(ks, outs, status, flags, outputs, n) -> dict:
@@ -84,7 +180,12 @@ def solve_batch(columns, model="rigid", outputs=None, engine: str = "local"):
     r2x r2y gamma e mu e_m`` for the rigid model, ``m1 m2 v1x v1y v2x v2y gamma
     e mu`` for particles. Units are consistent SI (kg, m, kg·m², m/s, rad/s)
     or US (slug, ft, slug·ft², ft/s, rad/s); `gamma` (the normal angle Γ) is in
-    radians. A fixed body is ``m = I = inf``. A scalar is the same value for
+    RADIANS: an angle in degrees by mistake gives a wrong speed and no flag.
+    Columns are checked as a scene file is (module docstring): an unknown
+    column, one the model does not read, or one that is not numbers (bool,
+    text, None) is a one-line ValueError naming it; no rows give an empty
+    result with every requested column. A row whose restitution e is outside
+    [0, 1] is solved and flagged (FLAG_E_OUT_OF_RANGE). A fixed body is ``m = I = inf``. A scalar is the same value for
     every row. ``mu="critical"`` uses the critical impulse ratio (no sliding
     at separation); `mu` may also be an array mixing numbers and "critical".
 
@@ -110,11 +211,13 @@ def solve_batch(columns, model="rigid", outputs=None, engine: str = "local"):
     ``status`` and ``flags`` (int32): see `impactsym.codes` for their meanings.
     """
     names, tier = _kernels.requested_outputs(outputs)
+    require_mapping(columns)
     if engine == "dask":
         return solve_batch_dask(columns, model=model, outputs=outputs)
     if engine != "local":
         raise ValueError(f"engine: unknown engine {engine!r} (use local or dask)")
     models, critical = _row_models(columns, model)
+    _check_forward_columns(columns, models)
     if isinstance(models, str) and not isinstance(critical, np.ndarray):
         return _like(columns, _solve_group(columns, models, critical, names, tier, mixed=False))
     return _like(columns, _solve_mixed(columns, models, critical, names, tier))
@@ -145,6 +248,21 @@ def _rows(columns: dict, start: int, stop: int) -> dict:
     """Rows start..stop-1 of every array column; scalars stay scalars."""
     return {name: column if np.ndim(column) == 0 else column[start:stop]
             for name, column in columns.items()}
+
+
+def _forward_inputs(model: str) -> tuple[str, ...]:
+    """The columns the forward kernel of a model name reads."""
+    return _kernels.kernel_for(_kernels.preset(model)[0], False).inputs
+
+
+def _check_forward_columns(columns, models) -> None:
+    """Every column is read by the batch's model (or, in a mixed batch, by one
+    of its models): `check_columns` with the forward kernels' inputs."""
+    names = [models] if isinstance(models, str) else sorted(set(models.tolist()))
+    everywhere = tuple(dict.fromkeys(c for family in _kernels.MODELS for c in _forward_inputs(family)))
+    known = tuple(dict.fromkeys(c for name in names for c in _forward_inputs(name))) or everywhere
+    label = f"the {names[0]} model" if len(names) == 1 else f"the models {', '.join(names)}"
+    check_columns(columns, known, label, everywhere)
 
 
 def _row_models(columns, model):

@@ -85,6 +85,10 @@ DISTRIBUTIONS = {"normal": ("mean", "sd"), "uniform": ("low", "high"),
 CRUSH_LEAVES = {"A": "stiffness_A", "B": "stiffness_B", "width": "crush_length",
                 "pdof": "angle", "moment_arm": "length", "radius_of_gyration": "length"}
 #: The domain of a leaf: what its nominal value and every draw must satisfy.
+#: The largest |angle| a leaf may give, in degrees. An angle is read modulo
+#: 360, but one beyond a million degrees is a slip of the keyboard (1e300 for
+#: 100), not a direction: it is refused rather than reduced.
+MAX_ANGLE_DEG = 1e6
 DOMAINS = {"any": ("", lambda x: np.isfinite(x)),
            "positive": ("positive ", lambda x: x > 0.0),
            "nonnegative": ("non-negative ", lambda x: x >= 0.0)}
@@ -98,12 +102,21 @@ def check_keys(data: Mapping, known: tuple[str, ...], path: str) -> None:
             raise SceneError(unknown_key(str(key), known), f"{path}.{key}" if path else str(key))
 
 
-def unknown_key(key: str, known: tuple[str, ...]) -> str:
-    """``unknown key; did you mean "restitution"?`` (difflib's nearest), or the list."""
-    close = difflib.get_close_matches(key, known, n=1, cutoff=0.6)
+def unknown_key(key: str, known: tuple[str, ...], word: str = "key",
+                aliases: Mapping[str, str] | None = None) -> str:
+    """``unknown key; did you mean "restitution"?`` (difflib's nearest), or the list.
+
+    ``word`` names what ``key`` is (``"column"`` for a batch). ``aliases`` maps
+    other spellings to a known key (a scene's ``restitution`` to a batch's
+    ``e``): a near miss of an alias suggests the key it stands for."""
+    spellings = {name: name for name in known}
+    spellings.update({alias: name for alias, name in (aliases or {}).items() if name in known})
+    close = difflib.get_close_matches(key, tuple(spellings), n=1, cutoff=0.6)
     if close:
-        return f'unknown key; did you mean "{close[0]}"?'
-    return f"unknown key (known here: {', '.join(known)})"
+        target = spellings[close[0]]
+        said = f' ({close[0]})' if target != close[0] else ""
+        return f'unknown {word}; did you mean "{target}"{said}?'
+    return f"unknown {word} (known here: {', '.join(known)})"
 
 
 @dataclass(frozen=True)
@@ -137,6 +150,8 @@ class LeafReader:
         else:
             leaf = Leaf(path, dimension, domain, self._plain(value, path, dimension, domain))
         _check_domain(leaf.nominal, value, path, domain)
+        if dimension == "angle":
+            _check_angle(leaf.nominal, path)
         self.leaves[path] = leaf
         return leaf.nominal
 
@@ -224,6 +239,13 @@ def _check_domain(nominal: float, raw: Any, path: str, domain: str) -> None:
         word = DOMAINS[domain][0]
         shown = show_value(raw) if not isinstance(raw, Mapping) else f"{nominal:g} (the nominal value)"
         raise SceneError(f"must be a {word}finite number, got {shown}", path)
+
+
+def _check_angle(degrees: float, path: str) -> None:
+    """A SceneError for an angle beyond ±MAX_ANGLE_DEG degrees (scene units)."""
+    if abs(degrees) > MAX_ANGLE_DEG:
+        raise SceneError(f"{degrees:g} degrees is not a usable angle: give it within [-360, 360] "
+                         f"(at most {MAX_ANGLE_DEG:g} degrees in magnitude)", path)
 
 
 def domain_reasons(leaves: Mapping[str, Leaf], values: Mapping[str, Any], n: int) -> np.ndarray:

@@ -10,8 +10,12 @@ unreadable file, a wrong argument) prints one line ``impactsym: error:
 from __future__ import annotations
 
 import argparse
+import io
 import json
+import os
+import signal
 import sys
+import threading
 import time
 from collections.abc import Callable
 from contextlib import contextmanager
@@ -20,23 +24,25 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _kernels, uncertainty_cli, warmup
+from ._version import __version__
+from .codes import describe_status
 from .compare import compare
 from .crash3 import crash3
 from .inverse import invert
 from .plot import add_plot_argument, save_plot
 from .reconstruct import reconstruct
-from .result import UNIT_LABELS, json_number, table_cell
+from .result import UNIT_LABELS, json_clean, json_number, table_cell
 from .scene import SceneError
 from .single import solve
 from .sweep import (
     CHUNK_SIZE,
     PERCENTILES,
-    SUMMARY_COLUMNS,
     SWEEP_PERCENTILES,
     GridPlan,
     SamplePlan,
     percentiles,
     summarize,
+    summary_columns,
     write_frame,
 )
 from .sweep import sweep as solve_sweep
@@ -45,6 +51,8 @@ __all__ = ["COMMANDS", "Command", "build_parser", "main"]
 
 PROG = "impactsym"
 EXIT_BAD_INPUT = 2
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
+EXIT_TERMINATED = 143  # 128 + SIGTERM
 
 
 @dataclass(frozen=True)
@@ -64,7 +72,18 @@ class _Parser(argparse.ArgumentParser):
     """An argument parser that raises :class:`UsageError` instead of printing usage and exiting."""
 
     def error(self, message: str):
-        raise UsageError(message)
+        raise UsageError(_once(message))
+
+
+def _once(message: str) -> str:
+    """argparse's ``argument --plot: <reason>`` without the option's name
+    when the reason already starts with it (``--plot out.txt: unknown image
+    type``): the name is said once."""
+    head, sep, reason = message.partition(": ")
+    names = head.removeprefix("argument ").split("/")
+    if sep and head.startswith("argument ") and reason.startswith(tuple(names)):
+        return reason
+    return message
 
 
 def _add_scene(parser: argparse.ArgumentParser) -> None:
@@ -84,7 +103,7 @@ def _add_solve(parser: argparse.ArgumentParser) -> None:
 def _print_result(result, as_json: bool) -> int:
     """Print a result as JSON or as a table; return exit code 0."""
     if as_json:
-        print(json.dumps(result.to_json_dict(), indent=2, allow_nan=False))
+        print(json.dumps(json_clean(result.to_json_dict()), indent=2, allow_nan=False))
     else:
         print(result.table())
     return 0
@@ -198,6 +217,7 @@ def _add_sweep(parser: argparse.ArgumentParser) -> None:
                              "the first varying slowest. Names: kernel inputs (e, mu, e_m, gamma "
                              "[rad], m1, v1x, ...) or normal_angle [deg], restitution, "
                              "impulse_ratio, moment_restitution")
+    parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     _add_run_options(parser)
     parser.add_argument("--plot", metavar="OUT.png",
                         help="also draw the sweep (1 or 2 varied parameters; needs matplotlib)")
@@ -228,6 +248,8 @@ def _parse_vary(text: str):
         if len(parts) != 3 or not parts[2].strip().isdigit() or int(parts[2]) < 1:
             raise UsageError(f"{option}: expected NAME=START:STOP:NUM with NUM a positive integer")
         start, stop = (_number(part, option) for part in parts[:2])
+        if not (np.isfinite(start) and np.isfinite(stop)):
+            raise UsageError(f"{option}: START and STOP must be finite numbers")
         return name, np.linspace(start, stop, int(parts[2]))
     if "," in spec:
         return name, [_grid_value(part.strip(), option) for part in spec.split(",")]
@@ -268,7 +290,10 @@ def _run_sweep(args: argparse.Namespace) -> int:
         else:
             summary = summarize(plan, out=args.out, q=SWEEP_PERCENTILES,
                                        **_run_options(args))
-    _print_summary(summary, plan.units, args.out)
+    if args.json:
+        print(json.dumps(json_clean(_summary_json(summary, plan.units)), indent=2, allow_nan=False))
+    else:
+        _print_summary(summary, plan.units, args.out)
     return 0
 
 
@@ -281,8 +306,7 @@ def _sweep_and_plot(args: argparse.Namespace, values: dict, varied: list, units:
                color=args.color, units=units)
     if args.out:
         write_frame(frame, args.out, tuple(varied))
-    return percentiles(frame, [c for c in SUMMARY_COLUMNS if c in frame],
-                              q=SWEEP_PERCENTILES)
+    return percentiles(frame, summary_columns(args.outputs), q=SWEEP_PERCENTILES)
 
 
 def _add_sample(parser: argparse.ArgumentParser) -> None:
@@ -317,7 +341,8 @@ def _run_sample(args: argparse.Namespace) -> int:
         plan = SamplePlan.build(args.scene, dists, args.n, args.seed, args.outputs)
         summary = summarize(plan, out=args.out, q=PERCENTILES, **_run_options(args))
     if args.json:
-        print(json.dumps(_summary_json(summary, plan), indent=2, allow_nan=False))
+        print(json.dumps(json_clean(_summary_json(summary, plan.units, plan.entropy)), indent=2,
+                         allow_nan=False))
     else:
         _print_summary(summary, plan.units, args.out, seed=plan.entropy)
     return 0
@@ -336,16 +361,25 @@ def _api_errors():
 
 def _unit(column: str, units: str) -> str:
     labels = UNIT_LABELS[units]
-    return labels["energy"] if column.startswith("TL") else labels["velocity"]
+    if column.startswith("TL"):
+        return labels["energy"]
+    return labels["yaw_rate"] if column[0] in "Ww" else labels["velocity"]
 
 
 def _print_summary(summary, units: str, out, seed=None) -> None:
-    """Counts, then one line per summarised output with its percentiles."""
+    """Counts, why rows were not solved, then one line per summarised output
+    with its percentiles (none when no row was solved: there is nothing to
+    summarise)."""
     counts = summary.attrs["counts"]
     if out:
         print(f"wrote {counts['rows']} rows to {out}")
     print(f"rows {counts['rows']}: solved {counts['solved']}, flagged {counts['flagged']}, "
           f"not solved {counts['not_solved']}" + (f"; seed {seed}" if seed is not None else ""))
+    for status, rows in counts.get("not_solved_by_status", {}).items():
+        print(f"  not solved, status {status}: {rows} rows: {describe_status(status)}")
+    if counts["solved"] == 0 and counts["rows"]:
+        print("no row was solved: no statistics (the reasons are above)")
+        return
     if summary.empty:
         return
     heads = [_SUMMARY_LABELS.get(label, label) for label in summary.columns]
@@ -355,12 +389,17 @@ def _print_summary(summary, units: str, out, seed=None) -> None:
         print(f"{label:<14}" + "".join(f"{table_cell(value):>14}" for value in row))
 
 
-def _summary_json(summary, plan) -> dict:
-    """The sample summary as a JSON object (percentile keys are the q values)."""
+def _summary_json(summary, units: str, seed=None) -> dict:
+    """The sweep or sample summary as a JSON object (percentile keys are the
+    q values; ``not_solved_by_status`` maps status codes to row counts; a
+    sample also gives its ``seed``)."""
+    counts = dict(summary.attrs["counts"])
+    counts["not_solved_by_status"] = {str(code): rows for code, rows
+                                      in counts.get("not_solved_by_status", {}).items()}
     return {
-        "units": plan.units,
-        "seed": plan.entropy,
-        **summary.attrs["counts"],
+        "units": units,
+        **({"seed": seed} if seed is not None else {}),
+        **counts,
         "percentiles": {column: {label[1:]: json_number(float(value)) for label, value in row.items()}
                         for column, row in summary.iterrows()},
     }
@@ -462,6 +501,7 @@ COMMANDS: dict[str, Command] = {
 def build_parser() -> argparse.ArgumentParser:
     """The ``impactsym`` parser with one sub-parser per entry of :data:`COMMANDS`."""
     parser = _Parser(prog=PROG, description="Impact phase of planar vehicle collisions.")
+    parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name, command in COMMANDS.items():
         command.add_arguments(commands.add_parser(name, help=command.help, description=command.help))
@@ -469,16 +509,66 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the command line; return the exit code (0 success, 2 bad input)."""
+    """Run the command line; return the exit code (0 success, 2 bad input,
+    130 interrupted by Ctrl-C; a reader that stops reading, as ``| head``
+    does, ends the command quietly with 1)."""
     try:
-        args = build_parser().parse_args(argv)
-        return COMMANDS[args.command].run(args)
+        with _terminate_as_exit():
+            args = build_parser().parse_args(argv)
+            code = COMMANDS[args.command].run(args)
+            sys.stdout.flush()  # a closed pipe shows here, not at interpreter exit
+            return code
+    except BrokenPipeError:
+        return _reader_gone()
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except _Terminated:
+        print(f"{PROG}: terminated", file=sys.stderr)
+        return EXIT_TERMINATED
     except (UsageError, SceneError) as exc:
         return _fail(str(exc))
     except OSError as exc:
         return _fail(f"{exc.filename}: {exc.strerror}" if exc.filename else str(exc))
     except SystemExit as exc:
         return exc.code if isinstance(exc.code, int) else 0
+
+
+class _Terminated(SystemExit):
+    """SIGTERM, raised as an exit so that every ``finally`` and ``with`` on
+    the way out runs (a sweep's spill folder is removed, a partial output
+    file deleted) instead of the process dying where it stands."""
+
+
+def _raise_terminated(signum, frame):
+    raise _Terminated(EXIT_TERMINATED)
+
+
+@contextmanager
+def _terminate_as_exit():
+    """SIGTERM raises :class:`_Terminated` while the command runs (the main
+    thread only: a signal handler cannot be set elsewhere); the previous
+    handler is restored after."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _reader_gone() -> int:
+    """stdout's reader has gone (``impactsym solve x.json --json | head -c 10``):
+    say nothing, and point stdout at devnull so that Python's final flush does
+    not fail again (the recipe of Python's signal documentation)."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, io.UnsupportedOperation):
+        pass  # stdout is not a file descriptor (captured in-process): nothing to flush
+    return 1
 
 
 def _fail(reason: str) -> int:

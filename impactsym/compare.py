@@ -148,11 +148,13 @@ class Comparison:
         return "\n".join(lines).rstrip("\n")
 
     def markdown(self) -> str:
-        """The same table as GitHub markdown."""
+        """The same table as GitHub markdown, with the same notes as the text
+        table: the models skipped and why, and each model's warnings."""
         headers, body = self._cells()
         lines = ["| " + " | ".join(_escape(headers)) + " |", "|" + "---|" * len(headers)]
         lines += ["| " + " | ".join(_escape(cells)) + " |" for cells in body]
         lines += [""] + [f"- skipped `{n}`: {reason}" for n, reason in self.skipped.items()]
+        lines += [f"- `{row.model}`: {warning}" for row in self.rows for warning in row.warnings]
         return "\n".join(lines).rstrip("\n")
 
     def plot(self, path: str | Path) -> None:

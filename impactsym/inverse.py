@@ -18,6 +18,7 @@ from .batch import run_columns
 from .codes import describe_flags, describe_status
 from .result import Result, VehicleResult, scene_warnings
 from .scene import Scene, SceneError, load_scene
+from .single import overflow_error
 
 _HINTS = {
     STATUS_NOT_APPROACHING: "for e > 0 the final velocities must separate at the impact centre, "
@@ -30,11 +31,16 @@ def invert_batch(columns, model: str = "rigid"):
 
     `columns` holds ``m1 m2 I1 I2 V1x V1y W1 V2x V2y W2 r1x r1y r2x r2y gamma e
     mu e_m`` (particles: ``m1 m2 V1x V1y V2x V2y gamma e mu``), float64 arrays or
-    scalars, units as in `solve_batch`. Returns ``v1x v1y w1 v2x v2y w2 Pn Pt M
+    scalars, units as in `solve_batch` (the normal angle ``gamma`` in RADIANS:
+    degrees given by mistake give a wrong result and no flag; columns checked
+    as strictly as there). Returns ``v1x v1y w1 v2x v2y w2 Pn Pt M
     mu_c TL TLn TLt TLm status flags``; status 7 (e too small) and 8 (e_m too
     small) mark rows whose finals do not determine the initials.
     """
-    return run_columns(_kernels.inverse_kernel_for(model), columns, _kernels.INVERSE_OUTPUTS)
+    everywhere = tuple(c for name in _kernels.INVERSE_MODELS
+                       for c in _kernels.inverse_kernel_for(name).inputs)
+    return run_columns(_kernels.inverse_kernel_for(model), columns, _kernels.INVERSE_OUTPUTS,
+                       f"the {model} model", everywhere)
 
 
 def invert(scene: Scene | Mapping | str | Path) -> Result:
@@ -46,6 +52,9 @@ def invert(scene: Scene | Mapping | str | Path) -> Result:
     out = _kernels.run_one(_kernels.inverse_kernel_for(scene.family), values,
                            _kernels.INVERSE_OUTPUTS)
     if out["status"] != 0:
+        overflow = overflow_error(scene, out["status"])
+        if overflow:
+            raise overflow
         hint = _HINTS.get(out["status"])
         reason = f"cannot invert the scene: {describe_status(out['status'])}"
         raise SceneError(f"{reason}; {hint}" if hint else reason)

@@ -48,9 +48,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from generated import codes as _codes
-
 from . import _kernels
+from ._kernels import CODES as _codes
 from .sweep import BLOCK, CHUNK_SIZE, SamplePlan
 from .uncertainty_commands import COMMANDS, COMPLEX_STEP, RECONSTRUCT, Command, command_for
 from .uncertainty_inputs import Input, cholesky, correlation_matrix

@@ -18,8 +18,9 @@ from typing import Any
 from . import _kernels
 from .batch import run_columns
 from .codes import describe_flags, describe_status
-from .result import UNIT_LABELS, json_number, road_speed_rows, table_cell
+from .result import UNIT_LABELS, json_number, road_speed_rows, table_cell, without_residue
 from .scene import Scene, SceneError, load_scene
+from .single import overflow_error
 
 OUTPUTS = ("s1", "s2", "v1x", "v1y", "v2x", "v2y", "Pn", "Pt", "M", "M_residual",
            "e", "mu", "e_m", "mu_c", "TL", "TLn", "TLt", "TLm", "pdof1", "pdof2")
@@ -29,12 +30,14 @@ def reconstruct_batch(columns):
     """Reconstruction for one scene per row.
 
     `columns`: ``m1 m2 I1 I2 V1x V1y W1 V2x V2y W2 theta1 theta2 w1 w2 r1x r1y
-    r2x r2y gamma`` (headings θ and normal angle Γ in radians; w = pre-impact
-    yaw rates). Returns ``s1 s2 v1x v1y v2x v2y Pn Pt M M_residual e mu e_m mu_c
+    r2x r2y gamma`` (headings θ and normal angle Γ in RADIANS: degrees given
+    by mistake give wrong speeds and no flag; w = pre-impact yaw rates), as a
+    dict or DataFrame; an unknown or non-numeric column is a one-line
+    ValueError naming it, as in `solve_batch`. Returns ``s1 s2 v1x v1y v2x v2y Pn Pt M M_residual e mu e_m mu_c
     TL TLn TLt TLm pdof1 pdof2`` (PDOF in radians, counter-clockwise from the
     heading, of the direction the impulse comes from) plus status and flags.
     """
-    return run_columns(_kernels.RECONSTRUCT, columns, OUTPUTS)
+    return run_columns(_kernels.RECONSTRUCT, columns, OUTPUTS, "the reconstruction")
 
 
 @dataclass(frozen=True)
@@ -117,8 +120,6 @@ class Reconstruction:
                 ("PDOF [o'clock]", one.pdof_clock, two.pdof_clock)]
         lines = [f"reconstruction, {self.units} units", "",
                  f"{'':<28}{one.name:>{width}}{two.name:>{width}}"]
-        lines += [f"{label:<28}{table_cell(a):>{width}}{table_cell(b):>{width}}" for label, a, b in rows]
-        lines.append("")
         implied = [("implied restitution e", self.e), ("implied impulse ratio mu", self.mu),
                    ("critical impulse ratio mu_c", self.mu_c),
                    ("implied moment restitution e_m", self.e_m),
@@ -126,6 +127,10 @@ class Reconstruction:
                    (f"  consistency residual [{labels['moment']}]", self.M_residual),
                    (f"energy loss TL {energy}", self.TL), (f"  normal TLn {energy}", self.TLn),
                    (f"  tangential TLt {energy}", self.TLt), (f"  moment TLm {energy}", self.TLm)]
+        clean = without_residue(rows + implied)  # rounding residue of a zero shown as 0
+        rows, implied = clean[:len(rows)], clean[len(rows):]
+        lines += [f"{label:<28}{table_cell(a):>{width}}{table_cell(b):>{width}}" for label, a, b in rows]
+        lines.append("")
         lines += [f"{label:<36}{table_cell(value):>14}" for label, value in implied]
         lines += ["", "warnings:"] + [f"  - {w}" for w in self.warnings] if self.warnings \
             else ["", "warnings: none"]
@@ -141,13 +146,32 @@ def reconstruct(scene: Scene | Mapping | str | Path) -> Reconstruction:
     values = _inputs(scene)
     out = _kernels.run_one(_kernels.RECONSTRUCT, values, OUTPUTS)
     if out["status"] != 0:
-        raise SceneError(f"cannot reconstruct the scene: {describe_status(out['status'])}")
+        raise overflow_error(scene, out["status"]) or SceneError(
+            f"cannot reconstruct the scene: {describe_status(out['status'])}")
     vehicles = tuple(_vehicle(v, out, values, i) for i, v in enumerate(scene.vehicles, 1))
     scalars = {k: out[k] for k in ("Pn", "Pt", "M", "M_residual", "e", "mu", "e_m", "mu_c",
                                    "TL", "TLn", "TLt", "TLm")}
     return Reconstruction(units=scene.units, vehicles=vehicles, flags=out["flags"],
-                          warnings=describe_flags(out["flags"]) + list(scene.warnings),
-                          **scalars)
+                          warnings=describe_flags(out["flags"]) + moment_warnings(out["e_m"])
+                          + list(scene.warnings), **scalars)
+
+
+#: The physical range of the moment restitution: e_m is the ratio of the final
+#: to the initial relative yaw rate at the impact, so TLm = (wr² - Wr²)/(2 Σj)
+#: is a loss only when |e_m| <= 1 (the range scenes are warned about too).
+MOMENT_RESTITUTION_RANGE = (-1.0, 1.0)
+
+
+def moment_warnings(e_m: float) -> list[str]:
+    """A warning when the implied moment restitution is outside its physical
+    range (a runtime check of the kernel's output; the kernel has no flag bit
+    for it)."""
+    low, high = MOMENT_RESTITUTION_RANGE
+    if not math.isfinite(e_m) or low <= e_m <= high:
+        return []
+    return [f"the implied moment restitution e_m = {e_m:.6g} is outside [{low:g}, {high:g}]: "
+            "the final relative yaw rate exceeds the initial one, which creates rotational "
+            "energy (TLm < 0); check the yaw rates, headings and impact centre"]
 
 
 def _inputs(scene: Scene) -> dict:

@@ -18,7 +18,7 @@ from .codes import describe_flags
 from .scene import Scene, uses_yaw
 
 __all__ = ["Result", "VehicleResult", "UNIT_LABELS", "ROAD_SPEED", "json_number", "road_speed_rows",
-           "scene_warnings", "table_cell"]
+           "scene_warnings", "table_cell", "without_residue", "TABLE_RESIDUE", "json_clean"]
 
 UNIT_LABELS = {
     "SI": {"velocity": "m/s", "yaw_rate": "rad/s", "impulse": "N·s", "moment": "N·m·s", "energy": "J"},
@@ -133,14 +133,18 @@ class Result:
         """A plain-text table for people, with unit labels and the warnings.
 
         The particle model has no yaw: its yaw-rate and moment rows are left out.
+        Rounding residue of a zero is shown as 0 (:func:`without_residue`).
         """
         one, two = self.vehicles
         width = max(14, len(one.name) + 2, len(two.name) + 2)
         lines = [f"{self.model} model, {self.units} units (impulses on vehicle 1, impact frame)", ""]
         lines.append(f"{'':<28}{one.name:>{width}}{two.name:>{width}}")
-        lines += [f"{label:<28}{table_cell(a):>{width}}{table_cell(b):>{width}}" for label, a, b in self._vehicle_rows()]
+        vehicle_rows, impact_rows = self._vehicle_rows(), self._impact_rows()
+        clean = without_residue(vehicle_rows + impact_rows)
+        vehicle_rows, impact_rows = clean[:len(vehicle_rows)], clean[len(vehicle_rows):]
+        lines += [f"{label:<28}{table_cell(a):>{width}}{table_cell(b):>{width}}" for label, a, b in vehicle_rows]
         lines.append("")
-        lines += [f"{label:<36}{table_cell(value):>14}" for label, value in self._impact_rows()]
+        lines += [f"{label:<36}{table_cell(value):>14}" for label, value in impact_rows]
         lines.append("")
         if self.warnings:
             lines += ["warnings:"] + [f"  - {text}" for text in self.warnings]
@@ -237,6 +241,52 @@ def table_cell(value: float) -> str:
     return f"{value + 0.0:.6g}"
 
 
+#: In a table (never in JSON or the API), a value smaller than this fraction
+#: of the largest magnitude printed in the same unit is shown as 0: it is
+#: rounding residue of a zero (7.3e-16 m/s beside 50 m/s), not a result.
+TABLE_RESIDUE = 1e-12
+
+
+def without_residue(rows: list[tuple]) -> list[tuple]:
+    """Table rows ``(label, *values)`` with rounding residue set to 0: a
+    float below :data:`TABLE_RESIDUE` times the largest finite magnitude among
+    the rows of the same unit (the ``[m/s]`` that ends the label; rows without
+    one, such as ratios, form one group)."""
+    scales: dict[str, float] = {}
+    for label, *values in rows:
+        unit = _unit_of(label)
+        scales[unit] = max([scales.get(unit, 0.0)] + [abs(v) for v in values if _is_float(v)])
+    return [(label, *(0.0 if _is_float(v) and abs(v) < TABLE_RESIDUE * scales[_unit_of(label)]
+                      else v for v in values)) for label, *values in rows]
+
+
+def _unit_of(label: str) -> str:
+    """The ``[unit]`` that ends a table label, or ``""``."""
+    head, bracket, unit = label.rstrip().rpartition("[")
+    return unit if bracket and unit.endswith("]") else ""
+
+
+def _is_float(value: Any) -> bool:
+    return isinstance(value, float) and math.isfinite(value)
+
+
+def json_clean(data: Any) -> Any:
+    """``data`` (dicts, lists, tuples, numbers, strings) with every float
+    through :func:`json_number`: what the commands print with ``--json``
+    (no ``-0.0``, no NaN), whichever result made it."""
+    if isinstance(data, Mapping):
+        return {key: json_clean(value) for key, value in data.items()}
+    if isinstance(data, (list, tuple)):
+        return [json_clean(value) for value in data]
+    if isinstance(data, float):
+        return json_number(data)
+    return data
+
+
 def json_number(value: float) -> float | None:
-    """``value``, or ``None`` when it is NaN or infinite (JSON has no such numbers)."""
-    return value if math.isfinite(value) else None
+    """``value``, or ``None`` when it is NaN or infinite (JSON has no such
+    numbers); a negative zero is written as 0.0 (``-0.0`` is rounding's sign,
+    not a direction)."""
+    if not math.isfinite(value):
+        return None
+    return value + 0.0 if value == 0 else value

@@ -297,20 +297,40 @@ def _read_file(path: Path) -> Any:
         raise SceneError(f"{path}: unknown scene file type {suffix or '(none)'!r} (use .json or .toml)")
     raw = path.read_bytes()
     try:
-        text = raw.decode("utf-8")
+        # utf-8-sig: a byte-order mark (as some Windows editors write) is dropped.
+        text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise SceneError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
-    if suffix == ".json":
-        try:
-            return json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise SceneError(f"{path}: invalid JSON: {exc}") from None
-        except RecursionError:
-            raise SceneError(f"{path}: invalid JSON: nested too deeply") from None
     try:
+        if suffix == ".json":
+            return json.loads(text, object_pairs_hook=_unique_keys)
         return tomllib.loads(text)
+    except json.JSONDecodeError as exc:
+        raise SceneError(f"{path}: invalid JSON: {exc}") from None
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path}: invalid TOML: {exc}") from None
+    except _DuplicateKey as exc:
+        raise SceneError(f'{path}: invalid JSON: the key "{exc.args[0]}" is given twice in one '
+                         "object (the second would silently replace the first)") from None
+    except RecursionError:
+        kind = "JSON" if suffix == ".json" else "TOML"
+        raise SceneError(f"{path}: invalid {kind}: nested too deeply") from None
+
+
+class _DuplicateKey(Exception):
+    """A JSON object that names one key twice (``args[0]`` is the key)."""
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """``json.loads``'s object hook: the object as a dict, refusing a key given
+    twice (json keeps the last one silently; a second ``"units"`` would relabel
+    every number of the scene)."""
+    data: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in data:
+            raise _DuplicateKey(key)
+        data[key] = value
+    return data
 
 
 class _Reading:
@@ -341,7 +361,7 @@ def _parse_scene(data: Any, source: Path | None, kind: str) -> Scene:
         raise SceneError(f"{where}a scene must be an object (a table of keys), got {show_value(data)}")
     check_keys(data, TOP_KEYS, "")
     model = _choice(data.get("model", "rigid"), "model", MODELS, "model")
-    units = _choice(_require(data, "units", ""), "units", UNITS, "units")
+    units = _units(_require(data, "units", ""))
     # CRASH3 uses the impact geometry only for delta-V directions and moment arms.
     no_impact = kind == "crash3" and "impact" not in data
     impact_data = {} if no_impact else _mapping(_require(data, "impact", ""), "impact")
@@ -631,6 +651,13 @@ def _choice(value: Any, path: str, allowed: tuple[str, ...], what: str) -> str:
         options = " or ".join(f'"{option}"' for option in allowed)
         raise SceneError(f"unknown {what} {show_value(value)} (use {options})", path)
     return value
+
+
+def _units(value: Any) -> str:
+    """The unit system, ``"SI"`` or ``"US"``, in any letter case (``"si"``)."""
+    if isinstance(value, str) and value.upper() in UNITS:
+        return value.upper()
+    return _choice(value, "units", UNITS, "units")
 
 
 def _flag(value: Any, path: str) -> bool:

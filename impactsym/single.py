@@ -2,16 +2,22 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from pathlib import Path
 
 from . import _kernels
-from ._kernels import STATUS_NOT_APPROACHING
+from ._kernels import STATUS_NOT_APPROACHING, STATUS_OVERFLOW
 from .codes import describe_status
 from .result import Result
 from .scene import Scene, SceneError, load_scene
 
-__all__ = ["solve", "status_reason"]
+__all__ = ["SAFE_MAGNITUDE", "overflow_error", "solve", "status_reason"]
+
+#: Magnitudes (scene units) within which the closed forms stay finite: they
+#: multiply and divide at most a few inputs, and (1e100)^3 = 1e300 < 1.8e308.
+#: An input outside is named when a solve overflows or underflows.
+SAFE_MAGNITUDE = (1e-100, 1e100)
 
 _HINTS = {
     STATUS_NOT_APPROACHING: "check impact.normal_angle and the vehicles' velocities and yaw rates",
@@ -29,8 +35,33 @@ def solve(scene: Scene | Mapping | str | Path) -> Result:
     model, critical, values = scene.to_inputs()
     out = _kernels.solve_one(model, critical, values)
     if out["status"] != 0:
-        raise SceneError(status_reason(out["status"]))
+        raise overflow_error(scene, out["status"]) or SceneError(status_reason(out["status"]))
     return Result.from_kernel(scene, out)
+
+
+def overflow_error(scene: Scene, status: int) -> SceneError | None:
+    """For a solve that overflowed (status 5), a SceneError naming the input
+    whose magnitude is furthest outside :data:`SAFE_MAGNITUDE` (a velocity of
+    1e308, a subnormal mass of 1e-320); None for another status or when every
+    non-zero input is within it."""
+    if status != STATUS_OVERFLOW:
+        return None
+    low, high = (math.log10(bound) for bound in SAFE_MAGNITUDE)
+    worst, beyond = None, 0.0
+    for path, leaf in scene.leaves.items():
+        size = abs(leaf.nominal)
+        if size == 0.0 or not math.isfinite(size):
+            continue
+        excess = max(math.log10(size) - high, low - math.log10(size))
+        if excess > beyond:
+            worst, beyond = path, excess
+    if worst is None:
+        return None
+    value = scene.leaves[worst].nominal
+    size = "large" if abs(value) > 1.0 else "small"
+    return SceneError(f"{value:g} is too {size}: the results of the impact are not finite (overflow); "
+                      f"keep every input between {SAFE_MAGNITUDE[0]:g} and {SAFE_MAGNITUDE[1]:g} "
+                      "in magnitude (scene units)", worst)
 
 
 def status_reason(status: int) -> str:

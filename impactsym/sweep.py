@@ -8,6 +8,13 @@ units, ``normal_angle`` in degrees), then the outputs of `solve_batch`, then
 generated kernels through `solve_batch`; this module only builds inputs,
 streams results and summarises them.
 
+Before any work, a run that cannot fit is refused with a one-line ValueError
+(`impactsym._resources`): rows held in memory beyond half of the available
+memory (use ``out=``), or percentile spill files beyond the free temporary
+space. The spill files live in a temporary folder removed on every way out
+(the end, an error, Ctrl-C; the command line turns SIGTERM into an exit so
+they are removed then too).
+
 Work runs in chunks of ``chunk_size`` rows: a chunk builds its own inputs from
 its (start, stop) row indices (grid rows by `numpy.unravel_index`, sample rows
 from fixed random blocks), so neither the grid nor the sample is ever held as
@@ -44,12 +51,13 @@ import numpy as np
 
 from ._plans import BLOCK, DISTRIBUTIONS, GridPlan, SamplePlan, check_outputs, frame_of, is_integer
 from ._quantiles import InMemory, StreamSummary, check_q, counts, summary_frame
+from ._resources import check_disk, check_memory
 from ._sinks import sink, write_frame, writing
 from ._util import CHUNK_SIZE, require, spans
 from .dask_engine import map_chunks
 from .scene import show_value
 
-__all__ = ["sweep", "sample", "percentiles", "GridPlan", "SamplePlan", "collect", "summarize",
+__all__ = ["sweep", "sample", "percentiles", "summary_columns", "GridPlan", "SamplePlan", "collect", "summarize",
            "write_frame",
            "CHUNK_SIZE", "BLOCK", "DISTRIBUTIONS", "PERCENTILES", "SWEEP_PERCENTILES"]
 
@@ -90,7 +98,7 @@ def sweep(scene, *, outputs=None, engine: str = "local", chunk_size: int = CHUNK
     column is text there) the rows are written chunk by chunk, memory stays
     bounded by ``chunk_size``, and the return value is the summary
     ``percentiles(rows, q=(0, 50, 100))`` (minimum, median, maximum of ``dV1
-    dV2 TL``, those the outputs include), exact: the summarised values of
+    dV2 TL``, those the outputs include: `summary_columns`), exact: the summarised values of
     solved rows spill to a temporary file (8 bytes each), not to memory.
 
     ``engine="dask"`` runs the chunks as dask tasks on the active
@@ -134,7 +142,7 @@ def sample(scene, dists: Mapping, n: int, *, seed=None, outputs=None, engine: st
     outputs, ``status``, ``flags``; see `sweep`). With ``out`` (``.parquet`` or
     ``.csv``) the rows go to the file chunk by chunk, memory stays bounded by
     ``chunk_size`` as for `sweep`, and the return value is the exact summary
-    ``percentiles(rows)`` (``dV1 dV2 TL``, those the outputs include, at
+    ``percentiles(rows)`` (`summary_columns`: ``dV1 dV2 TL`` or the velocities, at
     5, 25, 50, 75, 95 %), with ``attrs["seed"]`` too.
     """
     plan = SamplePlan.build(scene, dists, n, seed, outputs)
@@ -145,6 +153,14 @@ def sample(scene, dists: Mapping, n: int, *, seed=None, outputs=None, engine: st
         result = collect(plan, engine=engine, chunk_size=chunk_size, progress=progress)
     result.attrs["seed"] = plan.entropy
     return result
+
+
+def summary_columns(outputs) -> list[str]:
+    """The outputs a summary reports: those of `SUMMARY_COLUMNS` that
+    ``outputs`` (a `solve_batch` tier or list) includes, or, when it includes
+    none of them (``"velocities"``), every output it has."""
+    names = check_outputs(outputs)
+    return [name for name in SUMMARY_COLUMNS if name in names] or list(names)
 
 
 def percentiles(df, columns=SUMMARY_COLUMNS, q=PERCENTILES):
@@ -183,6 +199,7 @@ def _frames(plan, engine: str, chunk_size: int) -> Iterator:
 def collect(plan, *, engine: str = "local", chunk_size: int = CHUNK_SIZE, progress=None):
     """Every row of ``plan`` in one DataFrame (index 0..rows-1)."""
     pd = require("pandas", extra="sweep", what="collect")
+    check_memory(plan.rows, _values_per_row(plan), _kind(plan))
     frames = list(_with_progress(_frames(plan, engine, chunk_size), plan.rows, progress))
     return frames[0] if len(frames) == 1 else pd.concat(frames)
 
@@ -193,10 +210,12 @@ def summarize(plan, *, out=None, q=PERCENTILES, engine: str = "local", chunk_siz
     path, or None for no file) and return ``percentiles`` of the rows for the
     default summary columns the outputs include, with bounded memory: the
     summarised values of solved rows spill to a temporary file (8 bytes per
-    value) and the percentiles are selected exactly from it."""
+    value) and the percentiles are selected exactly from it. The columns are
+    `summary_columns` of the plan's outputs."""
     pd = require("pandas", extra="sweep", what="streaming")
     q = check_q(q)
-    columns = [name for name in SUMMARY_COLUMNS if name in check_outputs(plan.outputs)]
+    columns = summary_columns(plan.outputs)
+    check_disk(plan.rows, len(columns), _kind(plan))
     frames = _frames(plan, engine, chunk_size)
     writer = sink(out, plan.repeated)
     frames = _with_progress(frames, plan.rows, progress)
@@ -210,6 +229,16 @@ def summarize(plan, *, out=None, q=PERCENTILES, engine: str = "local", chunk_siz
         finally:
             summary.close()
         return summary_frame(pd, summary.stats, q, summary.counts)
+
+
+def _kind(plan) -> str:
+    return "sweep" if isinstance(plan, GridPlan) else "sample"
+
+
+def _values_per_row(plan) -> int:
+    """8-byte values of one row of a plan's frame: the varied inputs, the
+    outputs, and status and flags (4 bytes each)."""
+    return len(plan.names) + len(check_outputs(plan.outputs)) + 1
 
 
 def _with_progress(frames: Iterator, rows: int, progress) -> Iterator:

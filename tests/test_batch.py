@@ -45,6 +45,9 @@ def test_bad_rows_get_a_status_and_the_other_rows_are_untouched():
         assert codes.describe_status(code) != "solved"
 
 
+PARTICLE_COLUMNS = ("m1", "m2", "v1x", "v1y", "v2x", "v2y", "gamma", "e", "mu")
+
+
 @pytest.mark.parametrize("critical", [False, True])
 def test_rigid_with_zero_lever_arms_is_the_particle_model(critical):
     """Seed eqs 10-15: central impacts of rigid bodies are particle impacts."""
@@ -55,7 +58,8 @@ def test_rigid_with_zero_lever_arms_is_the_particle_model(critical):
     if critical:
         c["mu"] = "critical"
     rigid = impactsym.solve_batch(c, model="rigid")
-    particle = impactsym.solve_batch(c, model="particle")
+    # Only the particle model's columns: the yaw columns would be refused as not used.
+    particle = impactsym.solve_batch({k: c[k] for k in PARTICLE_COLUMNS}, model="particle")
     ok = (rigid["status"] == 0) & (particle["status"] == 0)
     assert ok.sum() > 250
     for name in ("V1x", "V1y", "V2x", "V2y", "Pn", "Pt", "TL", "TLn", "TLt", "mu_c"):

@@ -158,6 +158,9 @@ def _mixed_batch(rigid, particle, n=300, seed=11):
     return models, cols
 
 
+PARTICLE_COLUMNS = ("m1", "m2", "v1x", "v1y", "v2x", "v2y", "gamma", "e", "mu")
+
+
 def _row_alone(models, cols, i):
     model = models[i]
     row = {k: np.asarray(v)[i:i + 1] for k, v in cols.items()}
@@ -167,6 +170,8 @@ def _row_alone(models, cols, i):
         row.pop("e_m")
     if model == "limpert":
         row.pop("e"), row.pop("mu")
+    if model == "particle":  # alone, the yaw columns would be refused as not used
+        row = {k: v for k, v in row.items() if k in PARTICLE_COLUMNS}
     return impactsym.solve_batch(row, model=model)
 
 

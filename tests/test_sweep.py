@@ -298,9 +298,12 @@ def test_percentiles_equal_numpy_over_solved_rows_with_counts():
     summary = impactsym.percentiles(df)
     solved = df["status"] == 0
     assert 0 < (~solved).sum() < 500
+    codes, rows = np.unique(df.loc[~solved, "status"], return_counts=True)
     assert summary.attrs["counts"] == {"rows": 5000, "solved": int(solved.sum()),
                                        "not_solved": int((~solved).sum()),
-                                       "flagged": int((df["flags"] != 0).sum())}
+                                       "flagged": int((df["flags"] != 0).sum()),
+                                       "not_solved_by_status": dict(zip(codes.tolist(),
+                                                                        rows.tolist()))}
     assert list(summary.index) == ["dV1", "dV2", "TL"]
     assert list(summary.columns) == ["p5", "p25", "p50", "p75", "p95"]
     for name in summary.index:
@@ -461,13 +464,18 @@ def test_cli_sample_prints_percentiles_and_json(tmp_path, capsys):
     df = impactsym.sample(US, {"e": ("uniform", 0, 0.3), "m1": ("normal", 100, 40)}, 3000, seed=12)
     summary = impactsym.percentiles(df)
     assert data["seed"] == 12 and data["units"] == "US"
-    assert {k: data[k] for k in ("rows", "solved", "not_solved", "flagged")} == summary.attrs["counts"]
+    assert {k: data[k] for k in ("rows", "solved", "not_solved", "flagged")} == {
+        k: summary.attrs["counts"][k] for k in ("rows", "solved", "not_solved", "flagged")}
+    assert data["not_solved_by_status"] == {str(k): v for k, v in
+                                            summary.attrs["counts"]["not_solved_by_status"].items()}
     assert data["percentiles"]["TL"]["95"] == summary.loc["TL", "p95"]
     code, out, err = run(capsys, *args, "-o", tmp_path / "s.csv")
     assert (code, err) == (0, "")
     lines = out.splitlines()
     assert lines[0] == f"wrote 3000 rows to {tmp_path / 's.csv'}" and lines[1].endswith("seed 12")
-    assert lines[2].split() == ["p5", "p25", "median", "p75", "p95"]
+    reasons = [line for line in lines[2:] if line.startswith("  not solved, status ")]
+    assert len(reasons) == len(summary.attrs["counts"]["not_solved_by_status"]) > 0
+    assert lines[2 + len(reasons)].split() == ["p5", "p25", "median", "p75", "p95"]
     back = pd.read_csv(tmp_path / "s.csv",
                        dtype={"status": "int32", "flags": "int32"})
     assert_same(back, df)
