@@ -95,8 +95,9 @@ def requested_outputs(outputs) -> tuple[tuple[str, ...], str]:
 FILL_BYTES = 64 << 20
 MIN_CHUNK = 1 << 16
 
-# Seconds a driver may compile before the user is told why the call waits.
-COMPILE_NOTICE_AFTER = 2.0
+# Seconds a driver may compile before the user is told why the call waits
+# (IMPACTSYM_COMPILE_NOTICE_AFTER overrides; "inf" silences the notice).
+COMPILE_NOTICE_AFTER = float(os.environ.get("IMPACTSYM_COMPILE_NOTICE_AFTER", "2"))
 
 
 def _set_numba_cache_dir() -> None:
@@ -314,7 +315,7 @@ def _columns_for(ks: KernelSet, inputs: list, n: int) -> tuple[list, bool]:
 def _compile_notice(ks: KernelSet, driver, parallel: bool):
     """A timer that says, after COMPILE_NOTICE_AFTER seconds, that the call
     waits for numba (once per machine); None when the driver is compiled."""
-    if driver.signatures:
+    if driver.signatures or math.isinf(COMPILE_NOTICE_AFTER):
         return None
     seconds = max(2, round(ks.operations / (20 if parallel else 35)))
     message = (f"impactsym: compiling the {ks.name} batch kernel for this machine "
