@@ -10,6 +10,7 @@ Topic pages dropped into docs/ (docs/<topic>.md) join the user guide through
 the glob in index.md without an edit here.
 """
 
+import json
 import re
 import runpy
 import sys
@@ -79,5 +80,19 @@ def _plain_docstring(app, what, name, obj, options, lines):
     lines[:] = [_escape_bars(line) for line in lines]
 
 
+def _python_notebook(app, docname, source):
+    """Every notebook of impactsym is Python: one saved without kernel metadata
+    gets ``language_info`` = python, so its cells are highlighted instead of
+    warning "No source code lexer found" (the file itself is left as it is)."""
+    if not str(app.env.doc2path(docname)).endswith(".ipynb"):
+        return
+    notebook = json.loads(source[0])
+    metadata = notebook.setdefault("metadata", {})
+    if "language_info" not in metadata and "kernelspec" not in metadata:
+        metadata["language_info"] = {"name": "python"}
+        source[0] = json.dumps(notebook)
+
+
 def setup(app):
     app.connect("autodoc-process-docstring", _plain_docstring)
+    app.connect("source-read", _python_notebook)
