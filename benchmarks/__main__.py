@@ -20,14 +20,12 @@ SUBCOMMANDS = {
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m benchmarks",
-                                     description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m benchmarks", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True, metavar="SUBCOMMAND")
     modules = {}
     for name, modname in SUBCOMMANDS.items():
         module = modules[name] = importlib.import_module(modname)
-        module.add_arguments(sub.add_parser(name, help=module.DESCRIPTION,
-                                            description=module.DESCRIPTION))
+        module.add_arguments(sub.add_parser(name, help=module.DESCRIPTION, description=module.DESCRIPTION))
     args = parser.parse_args(argv)
     return modules[args.command].main(args)
 

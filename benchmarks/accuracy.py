@@ -51,18 +51,36 @@ from pathlib import Path
 import numpy as np
 
 RESULTS = Path(__file__).resolve().parent / "results"
-OUTPUTS = ("V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M",
-           "mu", "mu_c", "TL", "TLn", "TLt", "TLm")
-INPUTS = ("m1", "m2", "I1", "I2", "v1x", "v1y", "w1", "v2x", "v2y", "w2",
-          "r1x", "r1y", "r2x", "r2y", "gamma", "e", "mu", "e_m")
+OUTPUTS = ("V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M", "mu", "mu_c", "TL", "TLn", "TLt", "TLm")
+INPUTS = (
+    "m1",
+    "m2",
+    "I1",
+    "I2",
+    "v1x",
+    "v1y",
+    "w1",
+    "v2x",
+    "v2y",
+    "w2",
+    "r1x",
+    "r1y",
+    "r2x",
+    "r2y",
+    "gamma",
+    "e",
+    "mu",
+    "e_m",
+)
 SET_NAMES = ("realistic", "stress")
-EXACT_Y = 1e-19   # where an error of exactly 0 is drawn
-FAIL_Y = 1e3      # where a failed (infinite) error is drawn
+EXACT_Y = 1e-19  # where an error of exactly 0 is drawn
+FAIL_Y = 1e3  # where a failed (infinite) error is drawn
 UNIT_ROUNDOFF = 2.0**-53
 TEST_TOL = 1e-12  # tests/test_accuracy.py
 
 
 # ------------------------------------------------------------------ methods
+
 
 @dataclass
 class Method:
@@ -142,7 +160,9 @@ def _kernel_bind(module, name: str, dtype) -> Callable[[dict], Callable[[], dict
         def run():
             driver(*args, *outs.values(), status, flags)
             return outs
+
         return run
+
     return bind
 
 
@@ -166,8 +186,9 @@ def _linear_bind(columns):
     def run():
         for start in range(0, n, LINEAR_CHUNK):
             stop = min(start + LINEAR_CHUNK, n)
-            _linear_chunk(cols, slice(start, stop), A[:stop - start], b[:stop - start], outs)
+            _linear_chunk(cols, slice(start, stop), A[: stop - start], b[: stop - start], outs)
         return outs
+
     return run
 
 
@@ -229,13 +250,29 @@ def _linear_chunk(cols, sl, A, b, outs):
         TLn = Pn * (gn + Gn) / 2
         TLt = Pt * (gt + Gt) / 2
         TLm = M * ((c["w2"] - c["w1"]) + (W2 - W1)) / 2
-    values = dict(V1x=V1x, V1y=V1y, W1=W1, V2x=V2x, V2y=V2y, W2=W2, Pn=Pn, Pt=Pt, M=M,
-                  mu=mu, mu_c=mu_c, TL=TLn + TLt + TLm, TLn=TLn, TLt=TLt, TLm=TLm)
+    values = dict(
+        V1x=V1x,
+        V1y=V1y,
+        W1=W1,
+        V2x=V2x,
+        V2y=V2y,
+        W2=W2,
+        Pn=Pn,
+        Pt=Pt,
+        M=M,
+        mu=mu,
+        mu_c=mu_c,
+        TL=TLn + TLt + TLm,
+        TLn=TLn,
+        TLt=TLt,
+        TLm=TLm,
+    )
     for k, v in values.items():
         outs[k][sl] = v
 
 
 # --- sympy.lambdify of the closed forms
+
 
 def _lambdify_bind_factory():
     import sympy as sp
@@ -255,9 +292,10 @@ def _lambdify_bind_factory():
         def run():
             with np.errstate(all="ignore"):
                 res = func(*args)
-            return {k: np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
-                    for k, v in zip(names, res)}
+            return {k: np.broadcast_to(np.asarray(v, dtype=np.float64), (n,)) for k, v in zip(names, res)}
+
         return run
+
     return bind
 
 
@@ -269,41 +307,71 @@ def build_methods() -> list[Method]:
     gen = planar_jit
     gen.MANIFEST = planar.MANIFEST
 
-    methods = [Method("default", "default",
-                      "generated/planar.py `rigid_batch`: strict IEEE float64, prange "
-                      "(what `impactsym.solve_batch` runs)",
-                      _kernel_bind(gen, "rigid", np.float64), opt_in=False)]
+    methods = [
+        Method(
+            "default",
+            "default",
+            "generated/planar.py `rigid_batch`: strict IEEE float64, prange "
+            "(what `impactsym.solve_batch` runs)",
+            _kernel_bind(gen, "rigid", np.float64),
+            opt_in=False,
+        )
+    ]
     for key, label, dtype, note in (
-        ("fastmath", "fastmath", np.float64,
-         'same formulas, `derive.emit.VARIANTS["fastmath"]` (`fastmath=True`)'),
-        ("float32", "float32", np.float32,
-         '`derive.emit.VARIANTS["float32"]`: float32 inputs, literals, arithmetic and outputs'),
-        ("ke_difference", "KE difference", np.float64,
-         "`derive.planar.ke_difference_kernel()`: TL = kinetic energy before - after "
-         "(the other outputs are the default's)"),
+        (
+            "fastmath",
+            "fastmath",
+            np.float64,
+            'same formulas, `derive.emit.VARIANTS["fastmath"]` (`fastmath=True`)',
+        ),
+        (
+            "float32",
+            "float32",
+            np.float32,
+            '`derive.emit.VARIANTS["float32"]`: float32 inputs, literals, arithmetic and outputs',
+        ),
+        (
+            "ke_difference",
+            "KE difference",
+            np.float64,
+            "`derive.planar.ke_difference_kernel()`: TL = kinetic energy before - after "
+            "(the other outputs are the default's)",
+        ),
     ):
         module = variant_module(key)
         methods.append(Method(key, label, note, _kernel_bind(module, module.KERNEL_NAME, dtype)))
-    methods.append(Method("linear", "linear solve",
-                          "9x9 system per row (conventions.md), `numpy.linalg.solve` batched in "
-                          f"chunks of {LINEAR_CHUNK} rows; a second solve (sticking) for mu_c; "
-                          "energies as work of Pn, Pt, M", _linear_bind))
-    methods.append(Method("lambdify", "lambdify",
-                          '`sympy.lambdify(inputs, outputs, "numpy", cse=True)` of the kernel\'s '
-                          "outputs expanded down to the inputs, on whole arrays",
-                          _lambdify_bind_factory()))
+    methods.append(
+        Method(
+            "linear",
+            "linear solve",
+            "9x9 system per row (conventions.md), `numpy.linalg.solve` batched in "
+            f"chunks of {LINEAR_CHUNK} rows; a second solve (sticking) for mu_c; "
+            "energies as work of Pn, Pt, M",
+            _linear_bind,
+        )
+    )
+    methods.append(
+        Method(
+            "lambdify",
+            "lambdify",
+            '`sympy.lambdify(inputs, outputs, "numpy", cse=True)` of the kernel\'s '
+            "outputs expanded down to the inputs, on whole arrays",
+            _lambdify_bind_factory(),
+        )
+    )
     return methods
 
 
 # ------------------------------------------------------------------ errors
 
+
 @dataclass
 class SetErrors:
     """Per-row errors of one method on one set."""
 
-    row: np.ndarray          # max over outputs of the natural-scale error
-    which: list              # the output that gave it
-    energy: np.ndarray       # |TL - TL_ref| / |TL_ref| where defined, else NaN
+    row: np.ndarray  # max over outputs of the natural-scale error
+    which: list  # the output that gave it
+    energy: np.ndarray  # |TL - TL_ref| / |TL_ref| where defined, else NaN
 
     @property
     def fails(self) -> int:
@@ -344,17 +412,20 @@ def set_errors(outs: dict, scene_set, energy_floor: float = 1e-10) -> SetErrors:
         with mp.workdps(R.DPS):
             if abs(ref["TL"]) >= energy_floor * scene_set.ke0[i]:
                 tl = got["TL"]
-                energy[i] = (float(abs(mp.mpf(tl) - ref["TL"]) / abs(ref["TL"]))
-                             if math.isfinite(tl) else math.inf)
+                energy[i] = (
+                    float(abs(mp.mpf(tl) - ref["TL"]) / abs(ref["TL"])) if math.isfinite(tl) else math.inf
+                )
     return SetErrors(row, which, energy)
 
 
 # ------------------------------------------------------------------ timing
 
+
 def tile(columns: dict, n: int) -> dict:
     """``columns`` repeated to ``n`` rows (contiguous float64)."""
-    return {k: np.ascontiguousarray(np.resize(np.asarray(v, dtype=np.float64), n))
-            for k, v in columns.items()}
+    return {
+        k: np.ascontiguousarray(np.resize(np.asarray(v, dtype=np.float64), n)) for k, v in columns.items()
+    }
 
 
 def _cpu_busy_seconds() -> float:
@@ -404,16 +475,19 @@ def time_methods(methods, columns: dict, repeat: int, log=print) -> dict[str, di
                 runs[m.key]()
                 samples[m.key].append((time.perf_counter_ns() - t0) / n)
             others.append(load.share)
-        log(f"  repeat {r + 1}/{repeat} (other processes {np.nanmax(others[-len(methods):]):.0%} "
-            "of the CPUs at most): " + ", ".join(
-            f"{m.label} {samples[m.key][-1]:.1f}" for m in methods) + " ns/scene")
-    out = {k: {"ns": float(np.median(v)), "samples": v, "warmup_s": warm[k]}
-           for k, v in samples.items()}
+        log(
+            f"  repeat {r + 1}/{repeat} (other processes {np.nanmax(others[-len(methods) :]):.0%} "
+            "of the CPUs at most): "
+            + ", ".join(f"{m.label} {samples[m.key][-1]:.1f}" for m in methods)
+            + " ns/scene"
+        )
+    out = {k: {"ns": float(np.median(v)), "samples": v, "warmup_s": warm[k]} for k, v in samples.items()}
     out["_other_cpu"] = float(np.nanmean(others)) if others else math.nan
     return out
 
 
 # ------------------------------------------------------------------ report
+
 
 def _fmt(x: float, fails: int = 0) -> str:
     if not math.isfinite(x):
@@ -463,11 +537,17 @@ def markdown(methods, timing, errors, sets, args) -> str:
         lines.append(
             f"| {m.label} | {t:.1f} | {t / d:.2f} | {_fmt(er.worst(), er.fails)} | "
             f"{_fmt(er.p99())} | {_fmt(es.worst(), es.fails)} | {_fmt(es.p99())} | "
-            f"{_bits(es.worst())} | {_fmt(er.energy_worst())} | {_fmt(es.energy_worst())} |")
-    lines += ["", "![run time against error](accuracy.png)", "",
-              "## Worst error by stress family", "",
-              "| family | rows | " + " | ".join(m.label for m in methods) + " |",
-              "|---|---:|" + "---:|" * len(methods)]
+            f"{_bits(es.worst())} | {_fmt(er.energy_worst())} | {_fmt(es.energy_worst())} |"
+        )
+    lines += [
+        "",
+        "![run time against error](accuracy.png)",
+        "",
+        "## Worst error by stress family",
+        "",
+        "| family | rows | " + " | ".join(m.label for m in methods) + " |",
+        "|---|---:|" + "---:|" * len(methods),
+    ]
     stress = sets["stress"]
     for fam, _ in S.FAMILIES:
         mask = stress.family == fam
@@ -481,12 +561,12 @@ def markdown(methods, timing, errors, sets, args) -> str:
     for m in methods:
         es = errors[m.key]["stress"]
         i = int(np.argmax(es.row))
-        lines.append(f"- {m.label}: {_fmt(es.row[i], es.fails)} — {stress.family[i]} row {i}, "
-                     f"output `{es.which[i]}`")
+        lines.append(
+            f"- {m.label}: {_fmt(es.row[i], es.fails)} — {stress.family[i]} row {i}, output `{es.which[i]}`"
+        )
     lines += ["", "## Methods", ""]
     for m in methods:
-        lines.append(f"- **{m.label}**{'' if not m.opt_in else ' (not offered at run time)'}: "
-                     f"{m.note}.")
+        lines.append(f"- **{m.label}**{'' if not m.opt_in else ' (not offered at run time)'}: {m.note}.")
     lines += ["", "## Stress families", ""]
     lines += [f"- **{fam}**: {text}." for fam, text in S.FAMILIES]
     lines += ["", "## Findings (generated from the numbers above)", ""]
@@ -494,18 +574,21 @@ def markdown(methods, timing, errors, sets, args) -> str:
     lines += ["", "Stress families where the default kernel is not the most accurate:", ""]
     lines += _family_findings(methods, errors, stress)
     lines += ["", "## Code measured", "", _code_state()]
-    lines += ["", "## Machine", "",
-              f"{platform.machine()}, {os.cpu_count()} CPUs, numba {numba.__version__} with "
-              f"{numba.get_num_threads()} threads, NumPy {np.__version__}, Python "
-              f"{platform.python_version()}. First call ({sets['realistic'].n} rows, includes "
-              "the JIT compile; the variants compile from scratch every run, the default "
-              "loads numba's cache): "
-              + ", ".join(f"{m.label} {timing[m.key].get('first_call_s', math.nan):.2f} s"
-                          for m in methods)
-              + ". The numba kernels use every thread (prange); `numpy.linalg.solve` and the "
-              "lambdified NumPy code run on one. Other processes used "
-              f"{timing['_other_cpu']:.0%} of the CPUs during the timed runs (mean)"
-              + (": the times are noisy." if timing["_other_cpu"] > 0.1 else ".")]
+    lines += [
+        "",
+        "## Machine",
+        "",
+        f"{platform.machine()}, {os.cpu_count()} CPUs, numba {numba.__version__} with "
+        f"{numba.get_num_threads()} threads, NumPy {np.__version__}, Python "
+        f"{platform.python_version()}. First call ({sets['realistic'].n} rows, includes "
+        "the JIT compile; the variants compile from scratch every run, the default "
+        "loads numba's cache): "
+        + ", ".join(f"{m.label} {timing[m.key].get('first_call_s', math.nan):.2f} s" for m in methods)
+        + ". The numba kernels use every thread (prange); `numpy.linalg.solve` and the "
+        "lambdified NumPy code run on one. Other processes used "
+        f"{timing['_other_cpu']:.0%} of the CPUs during the timed runs (mean)"
+        + (": the times are noisy." if timing["_other_cpu"] > 0.1 else "."),
+    ]
     return "\n".join(lines) + "\n"
 
 
@@ -519,8 +602,10 @@ def _code_state() -> str:
     found = re.search(r"derive source sha256 ([0-9a-f]{64})", gen.read_text())
     generated = found.group(1) if found else "?"
     current = emit.source_hash()
-    text = (f"generated/planar.py header: derive source sha256 `{generated[:16]}…`; the variants "
-            f"were rendered from derive/ at `{current[:16]}…`")
+    text = (
+        f"generated/planar.py header: derive source sha256 `{generated[:16]}…`; the variants "
+        f"were rendered from derive/ at `{current[:16]}…`"
+    )
     if generated != current:
         return text + " — **generated/ is stale**: run `python -m derive`, then this benchmark."
     return text + " (the same source)."
@@ -539,18 +624,21 @@ def _findings(methods, timing, errors) -> list[str]:
                 parts.append(f"fails {mine.fails} {s} rows")
             elif base.worst() > 0:
                 ratio = mine.worst() / base.worst()
-                parts.append(f"worst {s} error {ratio:.3g}× the default's "
-                             f"({_fmt(mine.worst())} vs {_fmt(base.worst())})")
+                parts.append(
+                    f"worst {s} error {ratio:.3g}× the default's "
+                    f"({_fmt(mine.worst())} vs {_fmt(base.worst())})"
+                )
         ew, bw = errors[m.key]["stress"].energy_worst(), errors["default"]["stress"].energy_worst()
         if math.isfinite(ew) and math.isfinite(bw) and bw > 0:
             parts.append(f"TL self-relative (stress) {ew / bw:.3g}× the default's")
         out.append("- " + "; ".join(parts) + ".")
-    better = [f"{m.label} on the {s} set "
-              f"({errors[m.key][s].worst() / errors['default'][s].worst():.2g}×)"
-              for m in methods[1:] for s in SET_NAMES
-              if errors[m.key][s].worst() < errors["default"][s].worst()]
-    out.append("- Worst row more accurate than the default's: "
-               + (", ".join(better) or "none") + ".")
+    better = [
+        f"{m.label} on the {s} set ({errors[m.key][s].worst() / errors['default'][s].worst():.2g}×)"
+        for m in methods[1:]
+        for s in SET_NAMES
+        if errors[m.key][s].worst() < errors["default"][s].worst()
+    ]
+    out.append("- Worst row more accurate than the default's: " + (", ".join(better) or "none") + ".")
     return out
 
 
@@ -566,9 +654,11 @@ def _family_findings(methods, errors, stress) -> list[str]:
         mine = float(np.max(errors[best.key]["stress"].row[mask]))
         if mine < base / 2:
             i = np.flatnonzero(mask)[int(np.argmax(errors["default"]["stress"].row[mask]))]
-            out.append(f"- **{fam}**: the default's worst is {_fmt(base)} (row {i}, output "
-                       f"`{errors['default']['stress'].which[i]}`); {best.label} reaches "
-                       f"{_fmt(mine)}, {base / max(mine, 1e-300):.2g}× better.")
+            out.append(
+                f"- **{fam}**: the default's worst is {_fmt(base)} (row {i}, output "
+                f"`{errors['default']['stress'].which[i]}`); {best.label} reaches "
+                f"{_fmt(mine)}, {base / max(mine, 1e-300):.2g}× better."
+            )
     return out or ["- On every stress family the default is within 2× of the best method."]
 
 
@@ -595,28 +685,64 @@ def chart(methods, timing, errors, path: Path, n: int) -> None:
             yw = FAIL_Y if not math.isfinite(w) else max(w, EXACT_Y)
             yp = FAIL_Y if not math.isfinite(p) else max(p, EXACT_Y)
             ax.plot([xs[i], xs[i]], [yp, yw], color=color, lw=1, alpha=0.6)
-            ax.scatter([xs[i]], [yw], s=70, color=color, zorder=3,
-                       marker="X" if not math.isfinite(w) else "o",
-                       label=m.label if s == SET_NAMES[0] else None)
-            ax.scatter([xs[i]], [yp], s=70, facecolors="none", edgecolors=color, zorder=3,
-                       marker="X" if not math.isfinite(p) else "o", linewidths=1.5)
+            ax.scatter(
+                [xs[i]],
+                [yw],
+                s=70,
+                color=color,
+                zorder=3,
+                marker="X" if not math.isfinite(w) else "o",
+                label=m.label if s == SET_NAMES[0] else None,
+            )
+            ax.scatter(
+                [xs[i]],
+                [yp],
+                s=70,
+                facecolors="none",
+                edgecolors=color,
+                zorder=3,
+                marker="X" if not math.isfinite(p) else "o",
+                linewidths=1.5,
+            )
             text = m.label + (f": fail ({err.fails} rows)" if err.fails else "")
             offset, ha = corners[rank[i] % len(corners)]
-            ax.annotate(text, (xs[i], yw), textcoords="offset points", fontsize=8, color=color,
-                        xytext=offset, ha=ha)
+            ax.annotate(
+                text, (xs[i], yw), textcoords="offset points", fontsize=8, color=color, xytext=offset, ha=ha
+            )
         for y, text, style in ((UNIT_ROUNDOFF, "2^-53", ":"), (TEST_TOL, "1e-12 (tests)", "--")):
             ax.axhline(y, color="grey", ls=style, lw=1)
-            ax.text(0.01, y * 1.8, text, fontsize=7, color="grey",
-                    transform=ax.get_yaxis_transform())
+            ax.text(0.01, y * 1.8, text, fontsize=7, color="grey", transform=ax.get_yaxis_transform())
         ax.axhline(FAIL_Y, color="red", ls="-", lw=0.5, alpha=0.4)
-        ax.text(0.01, FAIL_Y * 1.8, "fail", fontsize=7, color="red",
-                transform=ax.get_yaxis_transform())
+        ax.text(0.01, FAIL_Y * 1.8, "fail", fontsize=7, color="red", transform=ax.get_yaxis_transform())
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_ylim(EXACT_Y / 3, FAIL_Y * 10)
         ax.set_xlim(min(xs) / 1.8, max(xs) * 3)
-        ticks = [t for t in (1, 2, 3, 5, 10, 20, 30, 50, 100, 200, 300, 500, 1000, 2000, 3000,
-                             5000, 10000, 20000, 50000) if min(xs) / 1.8 <= t <= max(xs) * 3]
+        ticks = [
+            t
+            for t in (
+                1,
+                2,
+                3,
+                5,
+                10,
+                20,
+                30,
+                50,
+                100,
+                200,
+                300,
+                500,
+                1000,
+                2000,
+                3000,
+                5000,
+                10000,
+                20000,
+                50000,
+            )
+            if min(xs) / 1.8 <= t <= max(xs) * 3
+        ]
         ax.xaxis.set_major_locator(FixedLocator(ticks))
         ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
         ax.xaxis.set_minor_formatter(NullFormatter())
@@ -624,9 +750,13 @@ def chart(methods, timing, errors, path: Path, n: int) -> None:
         ax.set_title(f"{s} set: worst (filled) and p99 (hollow) error")
         ax.grid(True, which="major", alpha=0.3)
     axes[0].set_ylabel("error / natural scale (0 drawn at the bottom)")
-    sec = axes[1].secondary_yaxis("right", functions=(
-        lambda y: np.log2(np.maximum(y, 1e-300)) + 53,
-        lambda b: np.exp2(np.clip(b - 53, -1000, 1000))))
+    sec = axes[1].secondary_yaxis(
+        "right",
+        functions=(
+            lambda y: np.log2(np.maximum(y, 1e-300)) + 53,
+            lambda b: np.exp2(np.clip(b - 53, -1000, 1000)),
+        ),
+    )
     sec.yaxis.set_major_locator(FixedLocator([0, 10, 20, 30, 40, 50, 60]))
     sec.yaxis.set_major_formatter(FormatStrFormatter("%d"))
     sec.yaxis.set_minor_locator(NullLocator())
@@ -644,8 +774,12 @@ DESCRIPTION = "run time against error of every solution method (Markdown table +
 def add_arguments(parser) -> None:
     parser.add_argument("--n", type=int, default=1_000_000, help="rows for timing (default 1e6)")
     parser.add_argument("--repeat", type=int, default=5, help="timed runs per method (median)")
-    parser.add_argument("--out", type=Path, default=RESULTS,
-                        help="folder for accuracy.md and accuracy.png (default benchmarks/results)")
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=RESULTS,
+        help="folder for accuracy.md and accuracy.png (default benchmarks/results)",
+    )
 
 
 def main(args) -> int:
@@ -669,8 +803,10 @@ def main(args) -> int:
             outs = m.bind(scene_sets[s].columns)()
             first_call.setdefault(m.key, time.perf_counter() - t0)
             errors[m.key][s] = set_errors(outs, scene_sets[s])
-        log(f"  errors {m.label}: realistic {_fmt(errors[m.key]['realistic'].worst())}, "
-            f"stress {_fmt(errors[m.key]['stress'].worst(), errors[m.key]['stress'].fails)}")
+        log(
+            f"  errors {m.label}: realistic {_fmt(errors[m.key]['realistic'].worst())}, "
+            f"stress {_fmt(errors[m.key]['stress'].worst(), errors[m.key]['stress'].fails)}"
+        )
     log(f"timing n = {args.n} ...")
     timing = time_methods(methods, tile(scene_sets["realistic"].columns, args.n), args.repeat, log)
     for key, seconds in first_call.items():
@@ -680,6 +816,8 @@ def main(args) -> int:
     (args.out / "accuracy.md").write_text(text)
     chart(methods, timing, errors, args.out / "accuracy.png", args.n)
     print(text)
-    log(f"wrote {args.out / 'accuracy.md'} and {args.out / 'accuracy.png'} "
-        f"in {time.perf_counter() - t_start:.0f} s")
+    log(
+        f"wrote {args.out / 'accuracy.md'} and {args.out / 'accuracy.png'} "
+        f"in {time.perf_counter() - t_start:.0f} s"
+    )
     return 0

@@ -32,8 +32,15 @@ def round_trip_errors(e: float, n: int = 2000, seed: int = 3):
     finals = {k: v for k, v in c.items() if k not in INITIALS}
     finals.update({k: fwd[k] for k in FINALS})
     inv = impactsym.invert_batch(finals)
-    scale = np.max([np.hypot(c["v1x"], c["v1y"]), np.hypot(c["v2x"], c["v2y"]),
-                    np.hypot(fwd["V1x"], fwd["V1y"]), np.hypot(fwd["V2x"], fwd["V2y"])], axis=0)
+    scale = np.max(
+        [
+            np.hypot(c["v1x"], c["v1y"]),
+            np.hypot(c["v2x"], c["v2y"]),
+            np.hypot(fwd["V1x"], fwd["V1y"]),
+            np.hypot(fwd["V2x"], fwd["V2y"]),
+        ],
+        axis=0,
+    )
     ok = (fwd["status"] == 0) & (inv["status"] == 0)
     errors = np.max([np.abs(inv[k] - c[k]) / scale for k in INITIALS if k[0] == "v"], axis=0)
     return errors[ok], fwd["flags"][ok] == 0
@@ -49,6 +56,8 @@ def main(args=None) -> int:
     print("|---|---|---|---|---|")
     for e in RESTITUTIONS:
         err, physical = round_trip_errors(e)
-        print(f"| {e:g} | {np.median(err):.1e} | {np.percentile(err, 99):.1e} "
-              f"| {err.max():.1e} | {err[physical].max():.1e} ({physical.sum()} rows) |")
+        print(
+            f"| {e:g} | {np.median(err):.1e} | {np.percentile(err, 99):.1e} "
+            f"| {err.max():.1e} | {err[physical].max():.1e} ({physical.sum()} rows) |"
+        )
     return 0

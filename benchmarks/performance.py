@@ -80,6 +80,7 @@ SEED = 20240611
 
 # ------------------------------------------------------------------ scenes
 
+
 def _approach(c: dict, nx, ny):
     """n.(u2 - u1) at the impact centre (particles: n.(v2 - v1))."""
     w1, w2 = c.get("w1", 0.0), c.get("w2", 0.0)
@@ -88,8 +89,9 @@ def _approach(c: dict, nx, ny):
     return nx * (u2x - u1x) + ny * (u2y - u1y)
 
 
-def approaching_scenes(n: int, seed: int, *, model: str = "rigid", gamma: float | None = None,
-                       e_m: float | None = None) -> dict:
+def approaching_scenes(
+    n: int, seed: int, *, model: str = "rigid", gamma: float | None = None, e_m: float | None = None
+) -> dict:
     """``n`` realistic approaching two-car scenes as solve_batch columns (SI).
 
     Masses 800-3000 kg, yaw inertias 1000-5000 kg m^2, speeds 0-30 m/s in any
@@ -143,9 +145,11 @@ def _ceiling_kernel(n_in: int, n_out: int) -> Callable:
 
         ins = [f"a{k}" for k in range(n_in)]
         outs = [f"o{k}" for k in range(n_out)]
-        lines = [f"def ceiling({', '.join(ins + outs)}, status, flags):",
-                 "    for i in prange(status.shape[0]):",
-                 f"        s = {' + '.join(f'{a}[i]' for a in ins)}"]
+        lines = [
+            f"def ceiling({', '.join(ins + outs)}, status, flags):",
+            "    for i in prange(status.shape[0]):",
+            f"        s = {' + '.join(f'{a}[i]' for a in ins)}",
+        ]
         lines += [f"        {o}[i] = s + {k}.0" for k, o in enumerate(outs)]
         lines += ["        status[i] = 0", "        flags[i] = 0"]
         namespace = {"prange": numba.prange}
@@ -164,10 +168,12 @@ def ceiling_call(columns: dict, n_out: int) -> Callable[[], None]:
     def run():
         outs = [np.empty(n) for _ in range(n_out)]
         kernel(*arrays, *outs, np.empty(n, dtype=np.int32), np.empty(n, dtype=np.int32))
+
     return run
 
 
 # ------------------------------------------------------------------ a shared machine
+
 
 def _own_cpu() -> float:
     """CPU seconds of this process (every thread) and of its waited-for children."""
@@ -231,17 +237,20 @@ class Quiet:
 
     def summary(self) -> str:
         """One sentence: the others' share by section, re-runs, time waited."""
-        parts = [f"section {k} {np.mean(v):.0%} (max {np.max(v):.0%})"
-                 for k, v in self.shares.items()]
+        parts = [f"section {k} {np.mean(v):.0%} (max {np.max(v):.0%})" for k, v in self.shares.items()]
         noisy = any(np.mean(v) > self.max_other for v in self.shares.values())
-        return ("Other processes' share of the CPUs during the timed blocks, mean: "
-                + ", ".join(parts) + f". Blocks re-run because others used more than "
-                f"{self.max_other:.0%}: {self.rerun}; waited {self.waited_s:.0f} s for a quiet "
-                f"machine (budget {self.budget_s:.0f} s)"
-                + (": **the machine was busy, the times are noisy**." if noisy else "."))
+        return (
+            "Other processes' share of the CPUs during the timed blocks, mean: "
+            + ", ".join(parts)
+            + f". Blocks re-run because others used more than "
+            f"{self.max_other:.0%}: {self.rerun}; waited {self.waited_s:.0f} s for a quiet "
+            f"machine (budget {self.budget_s:.0f} s)"
+            + (": **the machine was busy, the times are noisy**." if noisy else ".")
+        )
 
 
 # ------------------------------------------------------------------ 1. throughput
+
 
 @dataclass
 class Case:
@@ -311,16 +320,34 @@ def build_cases(n: int, log) -> list[Case]:
     rigid, velocities = ("rigid", False, False, "energy"), ("rigid", False, False, "velocities")
     cases = [
         Case("a", "(a) rigid, per-row angle, all outputs", general, {}, rigid, 0.50),
-        Case("b", "(b) rigid, constant normal (gamma scalar), all outputs", constant, {}, rigid,
-             0.70),
-        Case("c", "(c) rigid, e_m = 1 on every row, all outputs", em1, {},
-             ("rigid", False, True, "energy"), 0.60),
-        Case("d", "(d) particle, all outputs", particle, {"model": "particle"},
-             ("particle", False, False, "energy"), 0.60),
-        Case("e", "(e) rigid, per-row angle, velocities tier", general, {"outputs": "velocities"},
-             velocities, None),
-        Case("crit", "rigid, mu = critical, all outputs", critical, {},
-             ("rigid", True, False, "energy"), None),
+        Case("b", "(b) rigid, constant normal (gamma scalar), all outputs", constant, {}, rigid, 0.70),
+        Case(
+            "c",
+            "(c) rigid, e_m = 1 on every row, all outputs",
+            em1,
+            {},
+            ("rigid", False, True, "energy"),
+            0.60,
+        ),
+        Case(
+            "d",
+            "(d) particle, all outputs",
+            particle,
+            {"model": "particle"},
+            ("particle", False, False, "energy"),
+            0.60,
+        ),
+        Case(
+            "e",
+            "(e) rigid, per-row angle, velocities tier",
+            general,
+            {"outputs": "velocities"},
+            velocities,
+            None,
+        ),
+        Case(
+            "crit", "rigid, mu = critical, all outputs", critical, {}, ("rigid", True, False, "energy"), None
+        ),
     ]
     for case in cases:
         case.arrays = sum(isinstance(v, np.ndarray) for v in case.columns.values())
@@ -339,7 +366,7 @@ def _time_round(cases: list[Case], runs: dict, r: int) -> dict:
     samples = {}
     for case in cases:
         n = case.columns["m1"].shape[0]
-        for what in order[r % 3:] + order[:r % 3]:
+        for what in order[r % 3 :] + order[: r % 3]:
             faults = _minor_faults()
             t0 = time.perf_counter_ns()
             runs[case.key][what]()
@@ -355,8 +382,11 @@ def time_cases(cases: list[Case], repeat: int, quiet: Quiet, log) -> dict:
     runs = {}
     ok = {}
     for case in cases:
-        runs[case.key] = {"ceiling": ceiling_call(case.columns, case.returned),
-                          "kernel": case.kernel_only(), "real": case.real()}
+        runs[case.key] = {
+            "ceiling": ceiling_call(case.columns, case.returned),
+            "kernel": case.kernel_only(),
+            "real": case.real(),
+        }
         for run in runs[case.key].values():
             run()  # warm-up: JIT compile of the ceiling, numba cache load, page faults
         ok[case.key] = float(np.mean(runs[case.key]["real"]()["status"] == 0))
@@ -368,9 +398,11 @@ def time_cases(cases: list[Case], repeat: int, quiet: Quiet, log) -> dict:
         for (key, what), (ns, faults) in samples.items():
             by_key[key].times[what].append(ns)
             by_key[key].faults[what].append(faults)
-        log(f"  round {r + 1}/{repeat} (others {quiet.shares['1'][-1]:.0%}): " + ", ".join(
-            f"{c.key} {c.times['real'][-1]:.1f}/{c.times['ceiling'][-1]:.1f}" for c in cases)
-            + " ns/scene (real/ceiling)")
+        log(
+            f"  round {r + 1}/{repeat} (others {quiet.shares['1'][-1]:.0%}): "
+            + ", ".join(f"{c.key} {c.times['real'][-1]:.1f}/{c.times['ceiling'][-1]:.1f}" for c in cases)
+            + " ns/scene (real/ceiling)"
+        )
     return ok
 
 
@@ -380,8 +412,10 @@ _ARITHMETIC = r"\bv(?:add|sub|mul|div|sqrt|f[n]?m(?:add|sub)\w*)"
 def _arithmetic(dispatcher) -> dict:
     """Packed and scalar float64 arithmetic instructions in a dispatcher's compiled code."""
     asm = "\n".join(dispatcher.inspect_asm().values())
-    return {"packed": len(re.findall(_ARITHMETIC + r"pd\b", asm)),
-            "scalar": len(re.findall(_ARITHMETIC + r"sd\b", asm))}
+    return {
+        "packed": len(re.findall(_ARITHMETIC + r"pd\b", asm)),
+        "scalar": len(re.findall(_ARITHMETIC + r"sd\b", asm)),
+    }
 
 
 def print_simd_counts(rows: int = 256) -> None:
@@ -402,21 +436,50 @@ def simd_counts() -> dict:
     """print_simd_counts run in a child process that compiles every driver afresh."""
     with tempfile.TemporaryDirectory(prefix="impactsym_numba_") as cache:
         child = subprocess.run(
-            [sys.executable, "-c", "from benchmarks.performance import print_simd_counts; "
-             "print_simd_counts()"], cwd=ROOT, env={**os.environ, "NUMBA_CACHE_DIR": cache},
-            check=True, capture_output=True, text=True)
+            [
+                sys.executable,
+                "-c",
+                "from benchmarks.performance import print_simd_counts; print_simd_counts()",
+            ],
+            cwd=ROOT,
+            env={**os.environ, "NUMBA_CACHE_DIR": cache},
+            check=True,
+            capture_output=True,
+            text=True,
+        )
     return json.loads(child.stdout.splitlines()[-1])
 
 
 # ------------------------------------------------------------------ 2. baselines
+
 
 def _row_system(c: dict, i: int) -> tuple:
     """The 15 outputs of row ``i`` the way a user would write it: the 9x9 system of
     conventions.md in (V1x V1y W1 V2x V2y W2 Px Py M) assembled from Python floats and
     solved by numpy.linalg.solve; a second solve with the sticking equation for mu_c."""
     m1, m2, I1, I2, v1x, v1y, w1, v2x, v2y, w2, r1x, r1y, r2x, r2y, gamma, e, mu, em = (
-        float(c[k][i]) for k in ("m1", "m2", "I1", "I2", "v1x", "v1y", "w1", "v2x", "v2y", "w2",
-                                 "r1x", "r1y", "r2x", "r2y", "gamma", "e", "mu", "e_m"))
+        float(c[k][i])
+        for k in (
+            "m1",
+            "m2",
+            "I1",
+            "I2",
+            "v1x",
+            "v1y",
+            "w1",
+            "v2x",
+            "v2y",
+            "w2",
+            "r1x",
+            "r1y",
+            "r2x",
+            "r2y",
+            "gamma",
+            "e",
+            "mu",
+            "e_m",
+        )
+    )
     k1, k2, j1, j2 = 1.0 / m1, 1.0 / m2, 1.0 / I1, 1.0 / I2
     nx, ny = math.cos(gamma), math.sin(gamma)
     tx, ty = -ny, nx
@@ -449,6 +512,7 @@ def time_python_loop(columns: dict, rows: int, repeat: int, quiet: Quiet) -> tup
     """(median over ``repeat`` passes, one quiet-gated block, of ns per row of the per-row
     loop over the first ``rows`` rows; its largest deviation from solve_batch on those
     rows relative to the row's largest speed)."""
+
     def passes():
         samples = []
         for _ in range(repeat):
@@ -530,9 +594,11 @@ def wait_call(kind: str, path: str) -> Callable[[], object]:
     (an .npz); inputs are built outside the call."""
     with np.load(path) as data:
         c = {k: data[k] for k in data.files}
-    scalars = {"mix: masses and inertias scalar": ("m1", "m2", "I1", "I2"),
-               "mix: e, mu, e_m scalar": ("e", "mu", "e_m"),
-               "mix: one normal, arms scalar": ("gamma", "r1x", "r1y", "r2x", "r2y")}
+    scalars = {
+        "mix: masses and inertias scalar": ("m1", "m2", "I1", "I2"),
+        "mix: e, mu, e_m scalar": ("e", "mu", "e_m"),
+        "mix: one normal, arms scalar": ("gamma", "r1x", "r1y", "r2x", "r2y"),
+    }
     if kind in scalars:
         mixed = {k: float(v[0]) if k in scalars[kind] else v for k, v in c.items()}
         return lambda: impactsym.solve_batch(mixed)
@@ -546,14 +612,21 @@ def wait_call(kind: str, path: str) -> Callable[[], object]:
     out = impactsym.solve_batch(rows)
     finals = {k: out[k] for k in ("V1x", "V1y", "W1", "V2x", "V2y", "W2")}
     if kind == "invert_batch":
-        columns = {**{k: rows[k] for k in ("m1", "m2", "I1", "I2", "r1x", "r1y", "r2x", "r2y",
-                                           "gamma", "e", "mu", "e_m")}, **finals}
+        columns = {
+            **{
+                k: rows[k]
+                for k in ("m1", "m2", "I1", "I2", "r1x", "r1y", "r2x", "r2y", "gamma", "e", "mu", "e_m")
+            },
+            **finals,
+        }
         return lambda: impactsym.invert_batch(columns)
     if kind == "reconstruct_batch":
-        columns = {**{k: rows[k] for k in ("m1", "m2", "I1", "I2", "w1", "w2", "r1x", "r1y",
-                                           "r2x", "r2y", "gamma")}, **finals,
-                   "theta1": np.arctan2(rows["v1y"], rows["v1x"]),
-                   "theta2": np.arctan2(rows["v2y"], rows["v2x"])}
+        columns = {
+            **{k: rows[k] for k in ("m1", "m2", "I1", "I2", "w1", "w2", "r1x", "r1y", "r2x", "r2y", "gamma")},
+            **finals,
+            "theta1": np.arctan2(rows["v1y"], rows["v1x"]),
+            "theta2": np.arctan2(rows["v2y"], rows["v2x"]),
+        }
         return lambda: impactsym.reconstruct_batch(columns)
     raise ValueError(f"unknown wait call {kind!r}")
 
@@ -570,8 +643,14 @@ def time_compile_waits(columns: dict, quiet: Quiet, runs: int = STARTUP_RUNS) ->
         np.savez(path, **columns)
 
         def child(script, *argv, env=None):
-            done = subprocess.run([sys.executable, "-c", script, *argv], cwd=ROOT, check=True,
-                                  capture_output=True, text=True, env=env)
+            done = subprocess.run(
+                [sys.executable, "-c", script, *argv],
+                cwd=ROOT,
+                check=True,
+                capture_output=True,
+                text=True,
+                env=env,
+            )
             return json.loads(done.stdout.splitlines()[-1])
 
         # The package's first use (warm cache for case (a)); its background compile of
@@ -580,15 +659,20 @@ def time_compile_waits(columns: dict, quiet: Quiet, runs: int = STARTUP_RUNS) ->
         quiet_env = {**os.environ, "IMPACTSYM_BACKGROUND_COMPILE": "0"}
         child(_FIRST_CALL, str(path), env=quiet_env)
         t0 = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "impactsym", "compile", "--quiet"], cwd=ROOT,
-                       check=True, env=quiet_env)
+        subprocess.run(
+            [sys.executable, "-m", "impactsym", "compile", "--quiet"], cwd=ROOT, check=True, env=quiet_env
+        )
         out["warmup_s"] = time.perf_counter() - t0
         for kind in WAIT_CALLS:
-            samples = [quiet.run("3", lambda k=kind: child(_WAIT, k, str(path), env=quiet_env))
-                       for _ in range(runs)]
+            samples = [
+                quiet.run("3", lambda k=kind: child(_WAIT, k, str(path), env=quiet_env)) for _ in range(runs)
+            ]
             waits = [s["first_s"] - s["steady_s"] for s in samples]
-            out["calls"][kind] = {"first_wait_s": waits[0], "min_wait_s": min(waits),
-                                  "steady_s": min(s["steady_s"] for s in samples)}
+            out["calls"][kind] = {
+                "first_wait_s": waits[0],
+                "min_wait_s": min(waits),
+                "steady_s": min(s["steady_s"] for s in samples),
+            }
         cold = []
         for _ in range(runs):
             with tempfile.TemporaryDirectory(prefix="impactsym_numba_") as cache:
@@ -608,9 +692,11 @@ def _stale_bytecode(path: Path) -> bool:
     except OSError:
         return True
     stat = path.stat()
-    return (head[:4] != importlib.util.MAGIC_NUMBER
-            or int.from_bytes(head[8:12], "little") != int(stat.st_mtime) & 0xFFFFFFFF
-            or int.from_bytes(head[12:16], "little") != stat.st_size & 0xFFFFFFFF)
+    return (
+        head[:4] != importlib.util.MAGIC_NUMBER
+        or int.from_bytes(head[8:12], "little") != int(stat.st_mtime) & 0xFFFFFFFF
+        or int.from_bytes(head[12:16], "little") != stat.st_size & 0xFFFFFFFF
+    )
 
 
 def bytecode_note() -> tuple[str, float]:
@@ -624,9 +710,12 @@ def bytecode_note() -> tuple[str, float]:
         compile(path.read_text(), str(path), "exec")
     seconds = time.perf_counter() - t0
     why = " (PYTHONDONTWRITEBYTECODE is set here)" if sys.dont_write_bytecode else ""
-    return (f"{len(stale)} of generated/'s modules have no up-to-date .pyc{why}: every fresh "
-            f"process compiles their source, {seconds:.2f} s of each start-up above; an "
-            "installed wheel has its .pyc files.", seconds)
+    return (
+        f"{len(stale)} of generated/'s modules have no up-to-date .pyc{why}: every fresh "
+        f"process compiles their source, {seconds:.2f} s of each start-up above; an "
+        "installed wheel has its .pyc files.",
+        seconds,
+    )
 
 
 def _impactsym_script() -> str:
@@ -659,8 +748,9 @@ def time_first_call(columns: dict, quiet: Quiet, runs: int = STARTUP_RUNS) -> di
         cmd = [sys.executable, "-c", _FIRST_CALL, str(path)]
 
         def once():
-            return json.loads(subprocess.run(cmd, cwd=ROOT, check=True, capture_output=True,
-                                             text=True).stdout)
+            return json.loads(
+                subprocess.run(cmd, cwd=ROOT, check=True, capture_output=True, text=True).stdout
+            )
 
         once()
         samples = [quiet.run("3", once) for _ in range(runs)]
@@ -670,6 +760,7 @@ def time_first_call(columns: dict, quiet: Quiet, runs: int = STARTUP_RUNS) -> di
 
 
 # ------------------------------------------------------------------ 4. serial threshold
+
 
 def _median_call_ns(calls: dict, repeat: int) -> dict:
     """Median ns of each zero-argument callable, called ``repeat`` times interleaved."""
@@ -693,12 +784,15 @@ def _threshold_calls(columns: dict, n: int) -> dict:
         def call():
             _kernels.SERIAL_BELOW = serial_below
             _kernels.run_batch(ks, inputs, n)
+
         return call
 
-    return {"serial": lambda: ks.serial(*inputs, *outs),
-            "parallel": lambda: ks.batch(*inputs, *outs),
-            "run_batch serial": through_run_batch(n + 1),
-            "run_batch parallel": through_run_batch(0)}
+    return {
+        "serial": lambda: ks.serial(*inputs, *outs),
+        "parallel": lambda: ks.batch(*inputs, *outs),
+        "run_batch serial": through_run_batch(n + 1),
+        "run_batch parallel": through_run_batch(0),
+    }
 
 
 def time_threshold(columns: dict, repeat: int) -> dict:
@@ -729,6 +823,7 @@ def crossover(table: dict, serial: str, parallel: str) -> int | None:
 
 # ------------------------------------------------------------------ 5. sweep
 
+
 def sweep_available() -> bool:
     """Whether impactsym/sweep.py defines ``sweep`` (another engineer is building it)."""
     path = ROOT / "impactsym" / "sweep.py"
@@ -743,8 +838,18 @@ def run_sweep(points: int) -> dict:
     k = max(1, round(math.sqrt(points)))
     with tempfile.TemporaryDirectory(prefix="impactsym_sweep_", dir="/tmp") as tmp:
         out = Path(tmp) / "sweep.parquet"
-        cmd = [_impactsym_script(), "sweep", SCENE_FILE, "--vary", f"e=0:0.4:{k}",
-               "--vary", f"mu=0:0.6:{k}", "-o", str(out), "--no-progress"]
+        cmd = [
+            _impactsym_script(),
+            "sweep",
+            SCENE_FILE,
+            "--vary",
+            f"e=0:0.4:{k}",
+            "--vary",
+            f"mu=0:0.6:{k}",
+            "-o",
+            str(out),
+            "--no-progress",
+        ]
         with open(Path(tmp) / "stderr.txt", "w+") as err:
             t0 = time.perf_counter()
             child = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=err)
@@ -756,13 +861,20 @@ def run_sweep(points: int) -> dict:
         size = out.stat().st_size if out.exists() else 0
     shown = ["impactsym"] + cmd[1:]
     shown[shown.index("-o") + 1] = "TMPDIR/sweep.parquet"
-    return {"command": " ".join(shown),
-            "rows": k * k, "wall_s": wall, "rows_per_s": k * k / wall, "exit_code": code,
-            "peak_rss_gb": usage.ru_maxrss / 2**20, "file_gb": size / 1e9,
-            "stderr": stderr[-2000:]}
+    return {
+        "command": " ".join(shown),
+        "rows": k * k,
+        "wall_s": wall,
+        "rows_per_s": k * k / wall,
+        "exit_code": code,
+        "peak_rss_gb": usage.ru_maxrss / 2**20,
+        "file_gb": size / 1e9,
+        "stderr": stderr[-2000:],
+    }
 
 
 # ------------------------------------------------------------------ targets and report
+
 
 @dataclass
 class Target:
@@ -786,8 +898,9 @@ class Target:
             return f"- **met** — {head}"
         short = self._fmt(abs(self.value - self.goal)).replace("%", "points")
         factor = self.goal / self.value if self.at_least else self.value / self.goal
-        return (f"- **missed** — {head}: by {short} ({factor:.2f}× off)"
-                + (f"; likely: {self.reason}" if self.reason else ""))
+        return f"- **missed** — {head}: by {short} ({factor:.2f}× off)" + (
+            f"; likely: {self.reason}" if self.reason else ""
+        )
 
     def _fmt(self, x: float) -> str:
         if self.unit == "%":
@@ -803,11 +916,16 @@ def _angle_note(cases: dict) -> str:
     import numba
 
     cost = per_round(cases["a"], cases["b"], "kernel", lambda p, q: p - q)
-    return (f"a per-row angle costs cos/sin on every row: {cost:.1f} ns/scene in the rigid "
-            f"kernel ((a) {cases['a'].median_ns('kernel'):.1f} against (b), one normal, "
-            f"{cases['b'].median_ns('kernel'):.1f})"
-            + ("" if numba.config.USING_SVML else
-               "; numba has no SVML here (intel-cmplr-lib-rt), so cos/sin stay scalar calls"))
+    return (
+        f"a per-row angle costs cos/sin on every row: {cost:.1f} ns/scene in the rigid "
+        f"kernel ((a) {cases['a'].median_ns('kernel'):.1f} against (b), one normal, "
+        f"{cases['b'].median_ns('kernel'):.1f})"
+        + (
+            ""
+            if numba.config.USING_SVML
+            else "; numba has no SVML here (intel-cmplr-lib-rt), so cos/sin stay scalar calls"
+        )
+    )
 
 
 def _ceiling_reason(case: Case, simd: dict, angle: str) -> str:
@@ -817,63 +935,143 @@ def _ceiling_reason(case: Case, simd: dict, angle: str) -> str:
     reasons = []
     if ceiling / kernel < case.target:
         ops = simd.get(case.key)
-        reasons.append(f"the kernel alone (run_batch) reaches only {ceiling / kernel:.0%} of the "
-                       "ceiling" + (f"; its loop is scalar code ({ops['packed']} packed / "
-                                    f"{ops['scalar']} scalar float64 arithmetic instructions): "
-                                    "compute-bound, not memory-bound"
-                                    if ops and ops["packed"] == 0 else ""))
+        reasons.append(
+            f"the kernel alone (run_batch) reaches only {ceiling / kernel:.0%} of the "
+            "ceiling"
+            + (
+                f"; its loop is scalar code ({ops['packed']} packed / "
+                f"{ops['scalar']} scalar float64 arithmetic instructions): "
+                "compute-bound, not memory-bound"
+                if ops and ops["packed"] == 0
+                else ""
+            )
+        )
         if isinstance(case.columns["gamma"], np.ndarray):
             reasons.append(angle)
     if (real - kernel) / real >= 0.1:
-        reasons.append(f"solve_batch around the kernel adds {real - kernel:.1f} ns/scene "
-                       f"({(real - kernel) / real:.0%}: validation, e_m check, filler arrays "
-                       "for outputs the kernel does not compute)")
-    return "; ".join(reasons) or (f"noise (kernel alone at {ceiling / kernel:.0%} of the "
-                                  f"ceiling, solve_batch layer {(real - kernel) / real:.0%})")
+        reasons.append(
+            f"solve_batch around the kernel adds {real - kernel:.1f} ns/scene "
+            f"({(real - kernel) / real:.0%}: validation, e_m check, filler arrays "
+            "for outputs the kernel does not compute)"
+        )
+    return "; ".join(reasons) or (
+        f"noise (kernel alone at {ceiling / kernel:.0%} of the "
+        f"ceiling, solve_batch layer {(real - kernel) / real:.0%})"
+    )
 
 
 def targets(cases: dict, simd: dict, base: dict, start: dict, sweep: dict | None) -> list[Target]:
     """Every target of the brief with its measured value."""
     angle = _angle_note(cases)
-    out = [Target(f"{c.label}: ceiling / real", c.ceiling_ratio(), c.target, True, "%",
-                  _ceiling_reason(c, simd, angle))
-           for c in cases.values() if c.target is not None]
+    out = [
+        Target(
+            f"{c.label}: ceiling / real",
+            c.ceiling_ratio(),
+            c.target,
+            True,
+            "%",
+            _ceiling_reason(c, simd, angle),
+        )
+        for c in cases.values()
+        if c.target is not None
+    ]
     a, e = cases["a"], cases["e"]
-    out.append(Target("(e) velocities tier speed-up over all outputs", speedup(a, e), 1.5, True,
-                      "×",
-                      f"the tier saves memory traffic (the all-outputs ceiling is "
-                      f"{a.median_ns('ceiling') / e.median_ns('ceiling'):.2f}× the velocities "
-                      "one) but the velocities need the whole impulse solution: kernel alone "
-                      f"{a.median_ns('kernel'):.1f} → {e.median_ns('kernel'):.1f} ns/scene, "
-                      f"{e.ceiling_ratio():.0%} of its own ceiling; {angle}"))
-    out.append(Target("Python loop of numpy.linalg.solve, per row vs impactsym (a)",
-                      base["loop_ns"] / a.median_ns("real"), 1000, True, "×",
-                      f"the loop costs {base['loop_ns'] / 1e3:.1f} µs per row (two 9x9 solves); "
-                      f"1000× would need impactsym at {base['loop_ns'] / 1000:.1f} ns/scene, "
-                      f"it runs at {a.median_ns('real'):.1f}; {angle}"))
-    out.append(Target("batched numpy.linalg.solve, per row vs impactsym (a)",
-                      base["stack_ns"] / a.median_ns("real"), 20, True, "×",
-                      f"impactsym runs at {a.median_ns('real'):.1f} ns/scene; {angle}"))
-    out.append(Target("`import impactsym`", start["import_s"], 0.5, False, "s",
-                      "numba imported by `import impactsym`" if start["numba_on_import"] else
-                      "numba is not imported; the time is numpy and impactsym's own modules"))
+    out.append(
+        Target(
+            "(e) velocities tier speed-up over all outputs",
+            speedup(a, e),
+            1.5,
+            True,
+            "×",
+            f"the tier saves memory traffic (the all-outputs ceiling is "
+            f"{a.median_ns('ceiling') / e.median_ns('ceiling'):.2f}× the velocities "
+            "one) but the velocities need the whole impulse solution: kernel alone "
+            f"{a.median_ns('kernel'):.1f} → {e.median_ns('kernel'):.1f} ns/scene, "
+            f"{e.ceiling_ratio():.0%} of its own ceiling; {angle}",
+        )
+    )
+    out.append(
+        Target(
+            "Python loop of numpy.linalg.solve, per row vs impactsym (a)",
+            base["loop_ns"] / a.median_ns("real"),
+            1000,
+            True,
+            "×",
+            f"the loop costs {base['loop_ns'] / 1e3:.1f} µs per row (two 9x9 solves); "
+            f"1000× would need impactsym at {base['loop_ns'] / 1000:.1f} ns/scene, "
+            f"it runs at {a.median_ns('real'):.1f}; {angle}",
+        )
+    )
+    out.append(
+        Target(
+            "batched numpy.linalg.solve, per row vs impactsym (a)",
+            base["stack_ns"] / a.median_ns("real"),
+            20,
+            True,
+            "×",
+            f"impactsym runs at {a.median_ns('real'):.1f} ns/scene; {angle}",
+        )
+    )
+    out.append(
+        Target(
+            "`import impactsym`",
+            start["import_s"],
+            0.5,
+            False,
+            "s",
+            "numba imported by `import impactsym`"
+            if start["numba_on_import"]
+            else "numba is not imported; the time is numpy and impactsym's own modules",
+        )
+    )
     for kind, wait in start.get("waits", {}).get("calls", {}).items():
-        out.append(Target(f"compile wait of a call never made before after first use, {kind}",
-                          wait["first_wait_s"], 1.0, False, "s",
-                          "a driver it needs (another kernel, or the other form of the same "
-                          "kernel) was not compiled by the first use; it compiles once per "
-                          "machine"))
-    out.append(Target("`impactsym solve` wall time", start["cli_s"], 0.6, False, "s",
-                      f"`import impactsym` alone takes {start['import_s']:.2f} s, of which "
-                      f"{start['source_compile_s']:.2f} s compile generated/ from source"))
+        out.append(
+            Target(
+                f"compile wait of a call never made before after first use, {kind}",
+                wait["first_wait_s"],
+                1.0,
+                False,
+                "s",
+                "a driver it needs (another kernel, or the other form of the same "
+                "kernel) was not compiled by the first use; it compiles once per "
+                "machine",
+            )
+        )
+    out.append(
+        Target(
+            "`impactsym solve` wall time",
+            start["cli_s"],
+            0.6,
+            False,
+            "s",
+            f"`import impactsym` alone takes {start['import_s']:.2f} s, of which "
+            f"{start['source_compile_s']:.2f} s compile generated/ from source",
+        )
+    )
     n = a.columns["m1"].shape[0]
-    out.append(Target(f"first solve_batch call ({n:,} rows), fresh process", start["call_s"], 1.0,
-                      False, "s", "the steady-state call takes "
-                      f"{a.median_ns('real') * n / 1e9:.2f} s; the rest is loading the cached "
-                      "kernels and first-touch page faults"))
+    out.append(
+        Target(
+            f"first solve_batch call ({n:,} rows), fresh process",
+            start["call_s"],
+            1.0,
+            False,
+            "s",
+            "the steady-state call takes "
+            f"{a.median_ns('real') * n / 1e9:.2f} s; the rest is loading the cached "
+            "kernels and first-touch page faults",
+        )
+    )
     if sweep and sweep["exit_code"] == 0:
-        out.append(Target(f"sweep of {sweep['rows']:,} rows, peak RSS", sweep["peak_rss_gb"], 1.5,
-                          False, "GB", "chunks or the writer's buffers held in memory"))
+        out.append(
+            Target(
+                f"sweep of {sweep['rows']:,} rows, peak RSS",
+                sweep["peak_rss_gb"],
+                1.5,
+                False,
+                "GB",
+                "chunks or the writer's buffers held in memory",
+            )
+        )
     return out
 
 
@@ -886,13 +1084,17 @@ def _git(*args: str) -> str:
 def code_state() -> str:
     """The code measured: commit, derive source hash of generated/planar.py, and
     uncommitted changes under impactsym/ and generated/ (others edit them meanwhile)."""
-    found = re.search(r"derive source sha256 ([0-9a-f]{64})",
-                      (ROOT / "generated" / "planar.py").read_text())
+    found = re.search(r"derive source sha256 ([0-9a-f]{64})", (ROOT / "generated" / "planar.py").read_text())
     dirty = _git("status", "--porcelain", "--", "impactsym", "generated").splitlines()
-    return (f"Code: commit `{_git('rev-parse', '--short', 'HEAD') or '?'}`, generated/planar.py "
-            f"from derive source `{found.group(1)[:12] if found else '?'}…`; "
-            + (f"uncommitted: {', '.join(line[3:] for line in dirty)}." if dirty
-               else "no uncommitted changes under impactsym/ or generated/."))
+    return (
+        f"Code: commit `{_git('rev-parse', '--short', 'HEAD') or '?'}`, generated/planar.py "
+        f"from derive source `{found.group(1)[:12] if found else '?'}…`; "
+        + (
+            f"uncommitted: {', '.join(line[3:] for line in dirty)}."
+            if dirty
+            else "no uncommitted changes under impactsym/ or generated/."
+        )
+    )
 
 
 def _machine() -> str:
@@ -900,19 +1102,35 @@ def _machine() -> str:
 
     cpu = "?"
     with contextlib.suppress(OSError, StopIteration):
-        cpu = next(line.split(":", 1)[1].strip()
-                   for line in Path("/proc/cpuinfo").read_text().splitlines()
-                   if line.startswith("model name"))
-    return (f"{platform.machine()} {cpu}, {os.cpu_count()} CPUs, numba {numba.__version__} "
-            f"({numba.get_num_threads()} threads, threading layer "
-            f"{numba.threading_layer()}, SVML {'on' if numba.config.USING_SVML else 'off'}), "
-            f"NumPy {np.__version__}, "
-            f"Python {platform.python_version()}")
+        cpu = next(
+            line.split(":", 1)[1].strip()
+            for line in Path("/proc/cpuinfo").read_text().splitlines()
+            if line.startswith("model name")
+        )
+    return (
+        f"{platform.machine()} {cpu}, {os.cpu_count()} CPUs, numba {numba.__version__} "
+        f"({numba.get_num_threads()} threads, threading layer "
+        f"{numba.threading_layer()}, SVML {'on' if numba.config.USING_SVML else 'off'}), "
+        f"NumPy {np.__version__}, "
+        f"Python {platform.python_version()}"
+    )
 
 
-def markdown(args, code: str, cases: dict, ok: dict, quiet: Quiet, simd: dict, base: dict,
-             start: dict, thresh: dict, sweep: dict | None, sweep_note: str,
-             goals: list[Target], elapsed: float) -> str:
+def markdown(
+    args,
+    code: str,
+    cases: dict,
+    ok: dict,
+    quiet: Quiet,
+    simd: dict,
+    base: dict,
+    start: dict,
+    thresh: dict,
+    sweep: dict | None,
+    sweep_note: str,
+    goals: list[Target],
+    elapsed: float,
+) -> str:
     """The results page."""
     n = args.n
     lines = [
@@ -945,87 +1163,103 @@ def markdown(args, code: str, cases: dict, ok: dict, quiet: Quiet, simd: dict, b
     for c in cases.values():
         real = c.median_ns("real")
         target = f"≥ {c.target:.0%}" if c.target else "–"
-        lines.append(f"| {c.label} | {c.arrays} / {c.returned}+2 | {real:.1f} | {1e3 / real:.1f} "
-                     f"| {c.median_ns('kernel'):.1f} | {c.median_ns('ceiling'):.1f} "
-                     f"| {c.ceiling_ratio():.0%} | {target} | {ok[c.key]:.4%} "
-                     f"| {np.median(c.faults['real']):.0f} / {np.median(c.faults['ceiling']):.0f} "
-                     f"| {_simd_cell(simd.get(c.key))} | {c.spread():.2f} |")
+        lines.append(
+            f"| {c.label} | {c.arrays} / {c.returned}+2 | {real:.1f} | {1e3 / real:.1f} "
+            f"| {c.median_ns('kernel'):.1f} | {c.median_ns('ceiling'):.1f} "
+            f"| {c.ceiling_ratio():.0%} | {target} | {ok[c.key]:.4%} "
+            f"| {np.median(c.faults['real']):.0f} / {np.median(c.faults['ceiling']):.0f} "
+            f"| {_simd_cell(simd.get(c.key))} | {c.spread():.2f} |"
+        )
     a, e = cases["a"], cases["e"]
-    lines += ["", f"Velocities tier speed-up over all outputs (a / e, real, median of the "
-              f"per-round ratios): **{speedup(a, e):.2f}×**; ceilings "
-              f"{a.median_ns('ceiling') / e.median_ns('ceiling'):.2f}×. The ceiling kernel "
-              f"itself compiles to {_simd_cell(simd.get('ceiling'))} packed / scalar "
-              "instructions.",
-              "",
-              "## 2. Against baselines a user would write",
-              "",
-              "The 9x9 system of conventions.md and a second solve (sticking) for mu_c, "
-              "energies as work: the outputs impactsym returns (without dV1, dV2).",
-              "",
-              "| method | rows timed | ns/scene | × impactsym (a) |",
-              "|---|---:|---:|---:|",
-              f"| impactsym.solve_batch, case (a) | {n:,} | {a.median_ns('real'):.1f} | 1 |",
-              f"| Python loop, numpy.linalg.solve per row | {base['loop_rows']:,} "
-              f"| {base['loop_ns']:,.0f} | {base['loop_ns'] / a.median_ns('real'):,.0f} |",
-              f"| numpy.linalg.solve on (rows, 9, 9) stacks (chunks of 65536) "
-              f"| {base['stack_rows']:,} | {base['stack_ns']:,.0f} "
-              f"| {base['stack_ns'] / a.median_ns('real'):,.1f} |",
-              "",
-              f"The loop's velocities agree with solve_batch to {base['loop_agreement']:.1e} of "
-              "the row's largest speed. NumPy's solve runs on one core, impactsym on "
-              f"{os.cpu_count()}.",
-              "",
-              f"## 3. Start-up (fresh processes, least of {start['waits']['runs']})",
-              "",
-              "| what | seconds | target |",
-              "|---|---:|---:|",
-              f"| `impactsym solve {SCENE_FILE}` (wall) | {start['cli_s']:.2f} | ≤ 0.6 |",
-              f"| `import impactsym` | {start['import_s']:.2f} | – |",
-              f"| first `solve_batch` call, {n:,} rows, case (a), numba cache warm "
-              f"| {start['call_s']:.2f} | ≤ 1 |",
-              f"| first `solve_batch` call, {n:,} rows, case (a), empty numba cache "
-              f"(first use on a machine) | {start['waits']['cold_first_call_s']:.2f} | – |",
-              "",
-              f"`import impactsym` imports numba: {start['numba_on_import']}.",
-              "",
-              start["bytecode_note"],
-              "",
-              "### Compile waits after first use (fresh processes)",
-              "",
-              "The package's first use: one `solve_batch` on case (a) (every column an array, "
-              "an angle per row) in its own process, then the compile of every other batch "
-              "driver that the first use starts in the background (`impactsym compile`, timed "
-              f"here in the foreground: {start['waits']['warmup_s']:.0f} s; it loads what is "
-              "cached already). Then each call below, never made before, "
-              f"in {start['waits']['runs']} fresh processes: wait = first run − second run of the call in the process "
-              "(loading, or compiling, the drivers it needs). *first*: the very first process; "
-              "*min*: least over the processes.",
-              "",
-              "| call | what | first wait s | min wait s | steady s | target |",
-              "|---|---|---:|---:|---:|---:|"]
+    lines += [
+        "",
+        f"Velocities tier speed-up over all outputs (a / e, real, median of the "
+        f"per-round ratios): **{speedup(a, e):.2f}×**; ceilings "
+        f"{a.median_ns('ceiling') / e.median_ns('ceiling'):.2f}×. The ceiling kernel "
+        f"itself compiles to {_simd_cell(simd.get('ceiling'))} packed / scalar "
+        "instructions.",
+        "",
+        "## 2. Against baselines a user would write",
+        "",
+        "The 9x9 system of conventions.md and a second solve (sticking) for mu_c, "
+        "energies as work: the outputs impactsym returns (without dV1, dV2).",
+        "",
+        "| method | rows timed | ns/scene | × impactsym (a) |",
+        "|---|---:|---:|---:|",
+        f"| impactsym.solve_batch, case (a) | {n:,} | {a.median_ns('real'):.1f} | 1 |",
+        f"| Python loop, numpy.linalg.solve per row | {base['loop_rows']:,} "
+        f"| {base['loop_ns']:,.0f} | {base['loop_ns'] / a.median_ns('real'):,.0f} |",
+        f"| numpy.linalg.solve on (rows, 9, 9) stacks (chunks of 65536) "
+        f"| {base['stack_rows']:,} | {base['stack_ns']:,.0f} "
+        f"| {base['stack_ns'] / a.median_ns('real'):,.1f} |",
+        "",
+        f"The loop's velocities agree with solve_batch to {base['loop_agreement']:.1e} of "
+        "the row's largest speed. NumPy's solve runs on one core, impactsym on "
+        f"{os.cpu_count()}.",
+        "",
+        f"## 3. Start-up (fresh processes, least of {start['waits']['runs']})",
+        "",
+        "| what | seconds | target |",
+        "|---|---:|---:|",
+        f"| `impactsym solve {SCENE_FILE}` (wall) | {start['cli_s']:.2f} | ≤ 0.6 |",
+        f"| `import impactsym` | {start['import_s']:.2f} | – |",
+        f"| first `solve_batch` call, {n:,} rows, case (a), numba cache warm | {start['call_s']:.2f} | ≤ 1 |",
+        f"| first `solve_batch` call, {n:,} rows, case (a), empty numba cache "
+        f"(first use on a machine) | {start['waits']['cold_first_call_s']:.2f} | – |",
+        "",
+        f"`import impactsym` imports numba: {start['numba_on_import']}.",
+        "",
+        start["bytecode_note"],
+        "",
+        "### Compile waits after first use (fresh processes)",
+        "",
+        "The package's first use: one `solve_batch` on case (a) (every column an array, "
+        "an angle per row) in its own process, then the compile of every other batch "
+        "driver that the first use starts in the background (`impactsym compile`, timed "
+        f"here in the foreground: {start['waits']['warmup_s']:.0f} s; it loads what is "
+        "cached already). Then each call below, never made before, "
+        f"in {start['waits']['runs']} fresh processes: wait = first run − second run of the call in the process "
+        "(loading, or compiling, the drivers it needs). *first*: the very first process; "
+        "*min*: least over the processes.",
+        "",
+        "| call | what | first wait s | min wait s | steady s | target |",
+        "|---|---|---:|---:|---:|---:|",
+    ]
     for kind, wait in start["waits"]["calls"].items():
-        lines.append(f"| {kind} | {WAIT_CALLS[kind]} | {wait['first_wait_s']:.2f} "
-                     f"| {wait['min_wait_s']:.2f} | {wait['steady_s']:.3f} | ≤ 1 |")
-    lines += ["",
-              "## 4. Serial threshold (rigid, all outputs; median µs per call)",
-              "",
-              "| n | serial | parallel | run_batch serial | run_batch parallel |",
-              "|---:|---:|---:|---:|---:|"]
+        lines.append(
+            f"| {kind} | {WAIT_CALLS[kind]} | {wait['first_wait_s']:.2f} "
+            f"| {wait['min_wait_s']:.2f} | {wait['steady_s']:.3f} | ≤ 1 |"
+        )
+    lines += [
+        "",
+        "## 4. Serial threshold (rigid, all outputs; median µs per call)",
+        "",
+        "| n | serial | parallel | run_batch serial | run_batch parallel |",
+        "|---:|---:|---:|---:|---:|",
+    ]
     for size, row in thresh["table"].items():
-        lines.append(f"| {size} | " + " | ".join(f"{row[k] / 1e3:.2f}" for k in
-                                                 ("serial", "parallel", "run_batch serial",
-                                                  "run_batch parallel")) + " |")
+        lines.append(
+            f"| {size} | "
+            + " | ".join(
+                f"{row[k] / 1e3:.2f}"
+                for k in ("serial", "parallel", "run_batch serial", "run_batch parallel")
+            )
+            + " |"
+        )
     lines += ["", thresh["verdict"], "", "## 5. Sweep", "", sweep_note, ""]
     if sweep:
-        lines += [f"`{sweep['command']}`: exit code {sweep['exit_code']}, {sweep['rows']:,} "
-                  f"rows in {sweep['wall_s']:.1f} s = {sweep['rows_per_s'] / 1e6:.2f} M rows/s, "
-                  f"peak RSS {sweep['peak_rss_gb']:.2f} GB, Parquet {sweep['file_gb']:.2f} GB "
-                  "(deleted). "
-                  f"solve_batch alone runs case (a) at {1e3 / a.median_ns('real'):.1f} M rows/s: "
-                  "the sweep's time goes mostly to building and writing the table "
-                  f"({sweep['file_gb'] / sweep['wall_s'] * 1e3:.0f} MB/s of Parquet). The rest "
-                  "of the machine (other processes, kernel threads writing the file back) kept "
-                  f"{sweep['other_cpu_share']:.0%} of the CPUs busy meanwhile.", ""]
+        lines += [
+            f"`{sweep['command']}`: exit code {sweep['exit_code']}, {sweep['rows']:,} "
+            f"rows in {sweep['wall_s']:.1f} s = {sweep['rows_per_s'] / 1e6:.2f} M rows/s, "
+            f"peak RSS {sweep['peak_rss_gb']:.2f} GB, Parquet {sweep['file_gb']:.2f} GB "
+            "(deleted). "
+            f"solve_batch alone runs case (a) at {1e3 / a.median_ns('real'):.1f} M rows/s: "
+            "the sweep's time goes mostly to building and writing the table "
+            f"({sweep['file_gb'] / sweep['wall_s'] * 1e3:.0f} MB/s of Parquet). The rest "
+            "of the machine (other processes, kernel threads writing the file back) kept "
+            f"{sweep['other_cpu_share']:.0%} of the CPUs busy meanwhile.",
+            "",
+        ]
         if sweep["exit_code"] != 0:
             lines += ["```", sweep["stderr"], "```", ""]
     lines += ["## Targets", ""] + [g.line() for g in goals]
@@ -1044,9 +1278,14 @@ def threshold_verdict(table: dict, tolerance: float = 0.05) -> str:
     runtime = crossover(table, "run_batch serial", "run_batch parallel")
     current = _kernels.SERIAL_BELOW
     cost, worst = max(
-        (row["run_batch serial" if n < current else "run_batch parallel"]
-         / min(row["run_batch serial"], row["run_batch parallel"]) - 1, n)
-        for n, row in table.items())
+        (
+            row["run_batch serial" if n < current else "run_batch parallel"]
+            / min(row["run_batch serial"], row["run_batch parallel"])
+            - 1,
+            n,
+        )
+        for n, row in table.items()
+    )
     first = table[min(table)]
     launch = first["parallel"] - first["serial"]
     overhead = first["run_batch serial"] - first["serial"]
@@ -1054,25 +1293,35 @@ def threshold_verdict(table: dict, tolerance: float = 0.05) -> str:
     def says(found):
         return "none (serial is faster up to the largest n)" if found is None else f"n = {found}"
 
-    text = (f"Crossover (smallest n from which parallel is faster at every larger n measured; "
-            f"n doubles, so it is known to a factor 2): direct {says(direct)}, through run_batch "
-            f"{says(runtime)}. SERIAL_BELOW = {current} "
-            + (f"costs at most {cost:.1%} over the faster way at any measured n (n = {worst}): "
-               if cost > 0 else "picks the faster way at every measured n: "))
+    text = (
+        f"Crossover (smallest n from which parallel is faster at every larger n measured; "
+        f"n doubles, so it is known to a factor 2): direct {says(direct)}, through run_batch "
+        f"{says(runtime)}. SERIAL_BELOW = {current} "
+        + (
+            f"costs at most {cost:.1%} over the faster way at any measured n (n = {worst}): "
+            if cost > 0
+            else "picks the faster way at every measured n: "
+        )
+    )
     suggested = runtime if runtime is not None else f"more than {max(table)}"
     if cost <= tolerance:
-        text += (f"the measurement supports it (within {tolerance:.0%}; the crossover suggests "
-                 f"{suggested}).")
+        text += f"the measurement supports it (within {tolerance:.0%}; the crossover suggests {suggested})."
     else:
         text += f"the measurement suggests {suggested}."
-    return text + (f" At n = {min(table)} a prange launch costs {launch / 1e3:.1f} µs "
-                   f"(parallel − serial) and run_batch's own work {overhead / 1e3:.1f} µs "
-                   "(allocation, argument handling).")
+    return text + (
+        f" At n = {min(table)} a prange launch costs {launch / 1e3:.1f} µs "
+        f"(parallel − serial) and run_batch's own work {overhead / 1e3:.1f} µs "
+        "(allocation, argument handling)."
+    )
 
 
 def command(args) -> str:
-    parts = [f"--n {args.n}", f"--repeat {args.repeat}", f"--max-other {args.max_other}",
-             f"--max-wait {args.max_wait:g}"]
+    parts = [
+        f"--n {args.n}",
+        f"--repeat {args.repeat}",
+        f"--max-other {args.max_other}",
+        f"--max-wait {args.max_wait:g}",
+    ]
     if args.sweep is not None:
         parts.append("--sweep" if args.sweep else "--no-sweep")
     parts.append(f"--sweep-points {args.sweep_points}")
@@ -1083,31 +1332,63 @@ def command(args) -> str:
 
 # ------------------------------------------------------------------ entry point
 
+
 def add_arguments(parser) -> None:
-    parser.add_argument("--n", type=lambda s: int(float(s)), default=1_000_000,
-                        help="scenes per call in section 1 (default 1e6)")
+    parser.add_argument(
+        "--n",
+        type=lambda s: int(float(s)),
+        default=1_000_000,
+        help="scenes per call in section 1 (default 1e6)",
+    )
     parser.add_argument("--repeat", type=int, default=7, help="timed rounds (median; default 7)")
-    parser.add_argument("--loop-rows", type=int, default=2000,
-                        help="rows of the Python-loop baseline (default 2000)")
-    parser.add_argument("--stack-rows", type=lambda s: int(float(s)), default=200_000,
-                        help="rows of the batched numpy.linalg.solve baseline (default 2e5)")
-    parser.add_argument("--threshold-repeat", type=int, default=301,
-                        help="calls per n and way in the serial-threshold section (default 301)")
-    parser.add_argument("--sweep", action=argparse.BooleanOptionalAction, default=None,
-                        help="run the impactsym sweep section (default: on when "
-                             "impactsym.sweep exists)")
-    parser.add_argument("--sweep-points", type=lambda s: int(float(s)), default=100_000_000,
-                        help="rows of the sweep (default 1e8)")
-    parser.add_argument("--max-other", type=float, default=0.10,
-                        help="re-run a timed block when other processes used more than this share "
-                             "of the CPUs (default 0.10)")
-    parser.add_argument("--max-wait", type=float, default=180.0,
-                        help="seconds to wait in all for a quiet machine (default 180)")
-    parser.add_argument("--quick", action="store_true",
-                        help="a short run: n <= 2e5, 3 repeats, small baselines, 2 start-up "
-                             "runs, no sweep (a few minutes; for checking, not for the record)")
-    parser.add_argument("--out", type=Path, default=RESULTS,
-                        help="folder for performance.md and performance.json")
+    parser.add_argument(
+        "--loop-rows", type=int, default=2000, help="rows of the Python-loop baseline (default 2000)"
+    )
+    parser.add_argument(
+        "--stack-rows",
+        type=lambda s: int(float(s)),
+        default=200_000,
+        help="rows of the batched numpy.linalg.solve baseline (default 2e5)",
+    )
+    parser.add_argument(
+        "--threshold-repeat",
+        type=int,
+        default=301,
+        help="calls per n and way in the serial-threshold section (default 301)",
+    )
+    parser.add_argument(
+        "--sweep",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="run the impactsym sweep section (default: on when impactsym.sweep exists)",
+    )
+    parser.add_argument(
+        "--sweep-points",
+        type=lambda s: int(float(s)),
+        default=100_000_000,
+        help="rows of the sweep (default 1e8)",
+    )
+    parser.add_argument(
+        "--max-other",
+        type=float,
+        default=0.10,
+        help="re-run a timed block when other processes used more than this share of the CPUs (default 0.10)",
+    )
+    parser.add_argument(
+        "--max-wait",
+        type=float,
+        default=180.0,
+        help="seconds to wait in all for a quiet machine (default 180)",
+    )
+    parser.add_argument(
+        "--quick",
+        action="store_true",
+        help="a short run: n <= 2e5, 3 repeats, small baselines, 2 start-up "
+        "runs, no sweep (a few minutes; for checking, not for the record)",
+    )
+    parser.add_argument(
+        "--out", type=Path, default=RESULTS, help="folder for performance.md and performance.json"
+    )
 
 
 def _sweep_section(args, log) -> tuple[dict | None, str]:
@@ -1115,17 +1396,22 @@ def _sweep_section(args, log) -> tuple[dict | None, str]:
     available = sweep_available()
     wanted = available if args.sweep is None else args.sweep
     if not wanted:
-        return None, ("Not run (`--no-sweep`)." if available else
-                      "Not run: `impactsym.sweep` does not exist yet (impactsym/sweep.py has no "
-                      "`def sweep`); the code to measure `impactsym sweep` is in place.")
+        return None, (
+            "Not run (`--no-sweep`)."
+            if available
+            else "Not run: `impactsym.sweep` does not exist yet (impactsym/sweep.py has no "
+            "`def sweep`); the code to measure `impactsym sweep` is in place."
+        )
     if not available:
         return None, "Not run: `impactsym.sweep` does not exist yet (`--sweep` was given)."
     log(f"5. sweep of {args.sweep_points:,} rows ...")
     with Load() as load:
         sweep = run_sweep(args.sweep_points)
     sweep["other_cpu_share"] = load.share
-    note = (f"The grid e = 0…0.4 × mu = 0…0.6 around `{SCENE_FILE}` through the CLI, "
-            "Parquet to /tmp; peak RSS of the child process.")
+    note = (
+        f"The grid e = 0…0.4 × mu = 0…0.6 around `{SCENE_FILE}` through the CLI, "
+        "Parquet to /tmp; peak RSS of the child process."
+    )
     return sweep, note
 
 
@@ -1148,13 +1434,20 @@ def main(args) -> int:
     general = cases["a"].columns
     stack_rows = min(args.stack_rows, args.n)
     loop_ns, agreement = time_python_loop(general, args.loop_rows, args.repeat, quiet)
-    base = {"loop_rows": args.loop_rows, "loop_ns": loop_ns, "loop_agreement": agreement,
-            "stack_rows": stack_rows,
-            "stack_ns": time_stacked(general, stack_rows, min(args.repeat, 3), quiet)}
+    base = {
+        "loop_rows": args.loop_rows,
+        "loop_ns": loop_ns,
+        "loop_agreement": agreement,
+        "stack_rows": stack_rows,
+        "stack_ns": time_stacked(general, stack_rows, min(args.repeat, 3), quiet),
+    }
     log("3. start-up and compile waits ...")
     runs = 2 if args.quick else STARTUP_RUNS
-    start = {"cli_s": time_cli_solve(quiet, runs), **time_first_call(general, quiet, runs),
-             "waits": time_compile_waits(general, quiet, runs)}
+    start = {
+        "cli_s": time_cli_solve(quiet, runs),
+        **time_first_call(general, quiet, runs),
+        "waits": time_compile_waits(general, quiet, runs),
+    }
     start["bytecode_note"], start["source_compile_s"] = bytecode_note()
     log("4. serial threshold ...")
     table = quiet.run("4", lambda: time_threshold(general, args.threshold_repeat))
@@ -1164,26 +1457,45 @@ def main(args) -> int:
     elapsed = time.perf_counter() - t_start
     if code_state() != code:
         code += " **The code changed during the run** (now: " + code_state() + ")"
-    text = markdown(args, code, cases, ok, quiet, simd, base, start, thresh, sweep, sweep_note,
-                    goals, elapsed)
+    text = markdown(
+        args, code, cases, ok, quiet, simd, base, start, thresh, sweep, sweep_note, goals, elapsed
+    )
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "performance.md").write_text(text)
-    record = {"command": command(args), "machine": _machine(), "code": code,
-              "elapsed_s": elapsed,
-              "other_cpu_share_by_section": quiet.shares, "blocks_rerun": quiet.rerun,
-              "waited_s": quiet.waited_s,
-              "cases": {k: {"label": c.label, "arrays_in": c.arrays, "outputs": c.returned,
-                            "status0_share": ok[k], "ceiling_ratio": c.ceiling_ratio(),
-                            "target": c.target, "ns_per_scene": c.times,
-                            "minor_faults_per_call": c.faults, "simd": simd.get(k)}
-                        for k, c in cases.items()},
-              "ceiling_simd": simd.get("ceiling"), "baselines": base, "startup": start,
-              "serial_threshold": {"table_ns": {str(k): v for k, v in table.items()},
-                                   "serial_below": _kernels.SERIAL_BELOW,
-                                   "verdict": thresh["verdict"]},
-              "sweep": sweep, "sweep_note": sweep_note,
-              "targets": [{"what": g.what, "value": g.value, "goal": g.goal, "met": g.met}
-                          for g in goals]}
+    record = {
+        "command": command(args),
+        "machine": _machine(),
+        "code": code,
+        "elapsed_s": elapsed,
+        "other_cpu_share_by_section": quiet.shares,
+        "blocks_rerun": quiet.rerun,
+        "waited_s": quiet.waited_s,
+        "cases": {
+            k: {
+                "label": c.label,
+                "arrays_in": c.arrays,
+                "outputs": c.returned,
+                "status0_share": ok[k],
+                "ceiling_ratio": c.ceiling_ratio(),
+                "target": c.target,
+                "ns_per_scene": c.times,
+                "minor_faults_per_call": c.faults,
+                "simd": simd.get(k),
+            }
+            for k, c in cases.items()
+        },
+        "ceiling_simd": simd.get("ceiling"),
+        "baselines": base,
+        "startup": start,
+        "serial_threshold": {
+            "table_ns": {str(k): v for k, v in table.items()},
+            "serial_below": _kernels.SERIAL_BELOW,
+            "verdict": thresh["verdict"],
+        },
+        "sweep": sweep,
+        "sweep_note": sweep_note,
+        "targets": [{"what": g.what, "value": g.value, "goal": g.goal, "met": g.met} for g in goals],
+    }
     (args.out / "performance.json").write_text(json.dumps(record, indent=1))
     print(text)
     log(f"wrote {args.out / 'performance.md'} and performance.json in {elapsed:.0f} s")

@@ -73,6 +73,7 @@ def realistic_set(n: int = REALISTIC_ROWS, seed: int = REALISTIC_SEED) -> dict:
 
 # ---------------------------------------------------------------- stress rows
 
+
 def _bases(k: int) -> list[dict]:
     """``k`` realistic scenes (accepted, well-conditioned) as rows of Python floats."""
     cols = scenes.random_realistic(k, seed=BASE_SEED)
@@ -94,10 +95,26 @@ def rear_end(e: float, closing: float = 1.0, common: float = 30.0) -> dict:
     m/s, car 1 (behind) ``closing`` m/s faster; normal along x, impulse ratio 0, no
     moment restitution loss (e_m = 1). Fast common motion, slow closing: the energy
     loss is a small difference of large kinetic energies."""
-    return dict(m1=1500.0, m2=1200.0, I1=1500.0 * 1.3**2, I2=1200.0 * 1.25**2,
-                v1x=common + closing, v1y=0.0, w1=0.0, v2x=common, v2y=0.0, w2=0.0,
-                r1x=2.25, r1y=0.375, r2x=-2.125, r2y=0.25,
-                gamma=0.0, e=e, mu=0.0, e_m=1.0)
+    return dict(
+        m1=1500.0,
+        m2=1200.0,
+        I1=1500.0 * 1.3**2,
+        I2=1200.0 * 1.25**2,
+        v1x=common + closing,
+        v1y=0.0,
+        w1=0.0,
+        v2x=common,
+        v2y=0.0,
+        w2=0.0,
+        r1x=2.25,
+        r1y=0.375,
+        r2x=-2.125,
+        r2y=0.25,
+        gamma=0.0,
+        e=e,
+        mu=0.0,
+        e_m=1.0,
+    )
 
 
 def _near_elastic(bases):
@@ -128,10 +145,26 @@ def _grazing():
     ]
     for s, a, b, (r1x, r1y), (r2x, r2y) in shapes:
         for e, e_m in ((0.0, 1.0), (0.3, 0.0)):
-            row = dict(m1=1400.0, m2=1700.0, I1=1400.0 * 1.2**2, I2=1700.0 * 1.4**2,
-                       v1x=s, v1y=a, w1=0.0, v2x=s - s * 2.0**-30, v2y=b, w2=0.0,
-                       r1x=r1x, r1y=r1y, r2x=r2x, r2y=r2y, gamma=0.0, e=e, mu=0.0,
-                       e_m=e_m)
+            row = dict(
+                m1=1400.0,
+                m2=1700.0,
+                I1=1400.0 * 1.2**2,
+                I2=1700.0 * 1.4**2,
+                v1x=s,
+                v1y=a,
+                w1=0.0,
+                v2x=s - s * 2.0**-30,
+                v2y=b,
+                w2=0.0,
+                r1x=r1x,
+                r1y=r1y,
+                r2x=r2x,
+                r2y=r2y,
+                gamma=0.0,
+                e=e,
+                mu=0.0,
+                e_m=e_m,
+            )
             mu_c = _mu_c(row)
             rows += [row, dict(row, mu=float(np.copysign(0.5, mu_c))), dict(row, mu=mu_c / 2)]
     return rows
@@ -156,7 +189,7 @@ def _yaw_inertias(bases):
         for which in ("I1", "I2", "both"):
             for p in range(-8, 9):
                 row = dict(base, e_m=e_m)
-                for key in (("I1", "I2") if which == "both" else (which,)):
+                for key in ("I1", "I2") if which == "both" else (which,):
                     row[key] = base[key] * 10.0**p
                 rows.append(_fraction_of_critical(row, 0.5))
     return rows
@@ -174,8 +207,9 @@ def _mu_at_critical(bases):
 
 def _moment_restitution(bases):
     """e_m in {0, 1e-9, -1e-9, 1}, mu = mu_c / 2 of that e_m."""
-    return [_fraction_of_critical(dict(base, e_m=e_m), 0.5)
-            for base in bases for e_m in (0.0, 1e-9, -1e-9, 1.0)]
+    return [
+        _fraction_of_critical(dict(base, e_m=e_m), 0.5) for base in bases for e_m in (0.0, 1e-9, -1e-9, 1.0)
+    ]
 
 
 def _speed_scales(bases):
@@ -209,11 +243,17 @@ def _closing(row: dict) -> float:
 
 
 FAMILIES = (
-    ("near-elastic", "e = 1 - 2^-k, k = 10..40, mu = 0, e_m = 1 (a rear-end bump at 30 m/s "
-                     "closing at 1 m/s, and a realistic scene)"),
-    ("grazing", "normal along x, x-speeds equal but for 2^-30, no yaw; mu = 0, 0.5, mu_c/2 "
-                "(not mu_c: there the scene's condition number is ~1e8 and every float64 method "
-                "errs by ~1e-8)"),
+    (
+        "near-elastic",
+        "e = 1 - 2^-k, k = 10..40, mu = 0, e_m = 1 (a rear-end bump at 30 m/s "
+        "closing at 1 m/s, and a realistic scene)",
+    ),
+    (
+        "grazing",
+        "normal along x, x-speeds equal but for 2^-30, no yaw; mu = 0, 0.5, mu_c/2 "
+        "(not mu_c: there the scene's condition number is ~1e8 and every float64 method "
+        "errs by ~1e-8)",
+    ),
     ("mass ratio", "m2/m1 = 1e-9..1e9 (I2 scaled alike), e_m = 1 or 0, mu = mu_c/2"),
     ("yaw inertia", "I1, I2 or both x 1e-8..1e8, e_m = 1 or 0, mu = mu_c/2"),
     ("mu at mu_c", "mu = mu_c and mu_c (1 - 1e-9) (mu_c from the reference)"),
@@ -248,8 +288,10 @@ def load_sets(realistic_rows: int = REALISTIC_ROWS) -> dict[str, SceneSet]:
     """Both sets with references: ``{"realistic": ..., "stress": ...}``. Every stress
     row is checked to approach (reference gn < 0) and to have a finite reference."""
     stress_cols, family = stress_set()
-    sets = {"realistic": with_references("realistic", realistic_set(realistic_rows)),
-            "stress": with_references("stress", stress_cols, family)}
+    sets = {
+        "realistic": with_references("realistic", realistic_set(realistic_rows)),
+        "stress": with_references("stress", stress_cols, family),
+    }
     for s in sets.values():
         for i, ref in enumerate(s.refs):
             assert ref["gn"] < 0, f"{s.name} row {i} ({s.family[i]}) does not approach"

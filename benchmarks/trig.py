@@ -96,7 +96,7 @@ def time_rounds(x, repeat: int, quiet: Quiet, section: str) -> dict[str, list[fl
 
     def one_round(r):
         out = {}
-        for k in keys[r % len(keys):] + keys[:r % len(keys)]:
+        for k in keys[r % len(keys) :] + keys[: r % len(keys)]:
             t0 = time.perf_counter()
             METHODS[k][1](x, s, c)
             out[k] = (time.perf_counter() - t0) / x.size * 1e9
@@ -111,25 +111,33 @@ def time_rounds(x, repeat: int, quiet: Quiet, section: str) -> dict[str, list[fl
 def summarise(times: dict[str, list[float]]) -> dict[str, dict[str, float]]:
     """Median ns/angle and median per-round ratio of every method to ``_sincos``."""
     base = times["sincos"]
-    return {k: {"ns": statistics.median(v),
-                "x": statistics.median(t / b for t, b in zip(v, base))} for k, v in times.items()}
+    return {
+        k: {"ns": statistics.median(v), "x": statistics.median(t / b for t, b in zip(v, base))}
+        for k, v in times.items()
+    }
 
 
 def markdown(args, counts, runs, quiet, accuracy) -> str:
-    head = (f"`python -m benchmarks trig --n {args.n} --repeat {args.repeat}` — "
-            f"{platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, numba "
-            f"{numba.__version__}, numpy {np.__version__}, Python {platform.python_version()}. "
-            f"n = {args.n:,} angles uniform on [-2π, 2π]; outputs preallocated; median over "
-            f"{args.repeat} rounds (methods in rotating order); *× sincos* is the median of the "
-            "per-round ratios time / time of `_sincos` (above 1: slower than `_sincos`).")
-    acc = (f"Accuracy (same run, 50-digit mpmath, {accuracy['points']} points from "
-           f"`derive.trig.proof_points`): max error sin {accuracy['sin']:.3f} ulp, cos "
-           f"{accuracy['cos']:.3f} ulp, for |x| ≤ SINCOS_LIMIT = {trig.SINCOS_LIMIT:.7g}. "
-           "tests/test_sincos.py checks many more points.")
-    legend = ("*packed / scalar*: float64 add/sub/mul/div/fma instructions in the compiled loop "
-              "(`vmulpd` etc. are SIMD; the scalar ones are the loop's remainder and set-up). "
-              "The libm loop calls `sincos` per element and does no other arithmetic; the copy "
-              "loop only moves data.")
+    head = (
+        f"`python -m benchmarks trig --n {args.n} --repeat {args.repeat}` — "
+        f"{platform.processor() or platform.machine()}, {os.cpu_count()} CPUs, numba "
+        f"{numba.__version__}, numpy {np.__version__}, Python {platform.python_version()}. "
+        f"n = {args.n:,} angles uniform on [-2π, 2π]; outputs preallocated; median over "
+        f"{args.repeat} rounds (methods in rotating order); *× sincos* is the median of the "
+        "per-round ratios time / time of `_sincos` (above 1: slower than `_sincos`)."
+    )
+    acc = (
+        f"Accuracy (same run, 50-digit mpmath, {accuracy['points']} points from "
+        f"`derive.trig.proof_points`): max error sin {accuracy['sin']:.3f} ulp, cos "
+        f"{accuracy['cos']:.3f} ulp, for |x| ≤ SINCOS_LIMIT = {trig.SINCOS_LIMIT:.7g}. "
+        "tests/test_sincos.py checks many more points."
+    )
+    legend = (
+        "*packed / scalar*: float64 add/sub/mul/div/fma instructions in the compiled loop "
+        "(`vmulpd` etc. are SIMD; the scalar ones are the loop's remainder and set-up). "
+        "The libm loop calls `sincos` per element and does no other arithmetic; the copy "
+        "loop only moves data."
+    )
     lines = [
         "# Vectorised sin/cos: `_sincos` against libm and numpy",
         "",
@@ -153,19 +161,29 @@ def add_arguments(parser) -> None:
     parser.add_argument("--n", type=int, default=1_000_000, help="angles per call (default 1e6)")
     parser.add_argument("--repeat", type=int, default=21, help="timed rounds (median; default 21)")
     parser.add_argument("--out", type=Path, default=RESULTS, help="folder for trig.md")
-    parser.add_argument("--max-other", type=float, default=0.10,
-                        help="wait until other processes use at most this share of the CPUs")
-    parser.add_argument("--max-wait", type=float, default=180.0,
-                        help="seconds to wait for a quiet machine in total (default 180)")
+    parser.add_argument(
+        "--max-other",
+        type=float,
+        default=0.10,
+        help="wait until other processes use at most this share of the CPUs",
+    )
+    parser.add_argument(
+        "--max-wait",
+        type=float,
+        default=180.0,
+        help="seconds to wait for a quiet machine in total (default 180)",
+    )
 
 
 def main(args) -> int:
     def log(msg):
         print(msg, file=sys.stderr, flush=True)
 
-    print("note: this machine is shared with other jobs right now; each round waits for a quiet "
-          "machine (up to --max-wait s in all), the others' CPU share is reported, and the "
-          "same-run ratios are the figures to compare")
+    print(
+        "note: this machine is shared with other jobs right now; each round waits for a quiet "
+        "machine (up to --max-wait s in all), the others' CPU share is reported, and the "
+        "same-run ratios are the figures to compare"
+    )
     x = np.random.default_rng(SEED).uniform(-2 * math.pi, 2 * math.pi, args.n)
     s, c = np.empty_like(x), np.empty_like(x)
     log("compiling ...")

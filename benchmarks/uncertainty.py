@@ -29,9 +29,26 @@ import numpy as np
 
 DESCRIPTION = "uncertainty: 1e6-draw reconstruction, Jacobian vs value kernels, streaming memory"
 
-FORWARD = {"m1": 1500.0, "m2": 1200.0, "I1": 2500.0, "I2": 2000.0, "v1x": 20.0, "v1y": 0.0,
-           "w1": 0.1, "v2x": 0.0, "v2y": 15.0, "w2": 0.0, "r1x": 2.0, "r1y": 0.3, "r2x": -0.5,
-           "r2y": -2.0, "gamma": 0.3, "e": 0.2, "mu": -0.4, "e_m": 0.8}
+FORWARD = {
+    "m1": 1500.0,
+    "m2": 1200.0,
+    "I1": 2500.0,
+    "I2": 2000.0,
+    "v1x": 20.0,
+    "v1y": 0.0,
+    "w1": 0.1,
+    "v2x": 0.0,
+    "v2y": 15.0,
+    "w2": 0.0,
+    "r1x": 2.0,
+    "r1y": 0.3,
+    "r2x": -0.5,
+    "r2y": -2.0,
+    "gamma": 0.3,
+    "e": 0.2,
+    "mu": -0.4,
+    "e_m": 0.8,
+}
 
 
 def _reconstruction_scene() -> dict:
@@ -40,15 +57,22 @@ def _reconstruction_scene() -> dict:
     from impactsym import solve_batch
 
     fwd = solve_batch({k: np.array([v]) for k, v in FORWARD.items()})
-    scene = {k: FORWARD[k] for k in ("m1", "m2", "I1", "I2", "w1", "w2", "r1x", "r1y", "r2x",
-                                     "r2y", "gamma")}
+    scene = {k: FORWARD[k] for k in ("m1", "m2", "I1", "I2", "w1", "w2", "r1x", "r1y", "r2x", "r2y", "gamma")}
     scene.update({k: float(fwd[k][0]) for k in ("V1x", "V1y", "W1", "V2x", "V2y", "W2")})
     return {**scene, "theta1": 0.0, "theta2": math.pi / 2}
 
 
 SCENE = _reconstruction_scene()
-UNCERTAIN = {"V1x": 0.3, "V1y": 0.3, "V2x": 0.3, "V2y": 0.3, "m1": 30.0, "m2": 30.0,
-             "theta1": 0.02, "theta2": 0.02}
+UNCERTAIN = {
+    "V1x": 0.3,
+    "V1y": 0.3,
+    "V2x": 0.3,
+    "V2y": 0.3,
+    "m1": 30.0,
+    "m2": 30.0,
+    "theta1": 0.02,
+    "theta2": 0.02,
+}
 
 
 def source():
@@ -85,8 +109,13 @@ def end_to_end(draws: int) -> dict:
     t_mc = _best(lambda: U.propagate(src, draws=draws, seed=2), repeat=2)
     t_kernel = _best(lambda: reconstruct_batch(cols), repeat=3)
     accepted = U.propagate(src, draws=draws, seed=2).accepted
-    return {"draws": draws, "accepted": accepted, "propagate_s": t_mc,
-            "reconstruct_batch_s": t_kernel, "ratio": t_mc / t_kernel}
+    return {
+        "draws": draws,
+        "accepted": accepted,
+        "propagate_s": t_mc,
+        "reconstruct_batch_s": t_kernel,
+        "ratio": t_mc / t_kernel,
+    }
 
 
 REPS = 200
@@ -101,19 +130,26 @@ def jacobian_vs_value(rows: int = 200_000) -> dict:
 
     out = {}
     point, reps = FORWARD, REPS
-    for name, value_ks, values in (("reconstruct", _kernels.RECONSTRUCT, SCENE),
-                                   ("rigid", _kernels.KERNELS[("rigid", False, False, "energy")],
-                                    point),
-                                   ("particle", _kernels.KERNELS[("particle", False, False, "energy")],
-                                    point)):
+    for name, value_ks, values in (
+        ("reconstruct", _kernels.RECONSTRUCT, SCENE),
+        ("rigid", _kernels.KERNELS[("rigid", False, False, "energy")], point),
+        ("particle", _kernels.KERNELS[("particle", False, False, "energy")], point),
+    ):
         jac = _kernels.JACOBIAN[name]
-        t_jac = _best(lambda jac=jac, v=values: [_kernels.run_one(jac, v, jac.outputs)
-                                                 for _ in range(REPS)]) / reps
-        t_val = _best(lambda ks=value_ks, v=values: [_kernels.run_one(ks, v, ks.outputs)
-                                                     for _ in range(REPS)]) / reps
+        t_jac = (
+            _best(lambda jac=jac, v=values: [_kernels.run_one(jac, v, jac.outputs) for _ in range(REPS)])
+            / reps
+        )
+        t_val = (
+            _best(lambda ks=value_ks, v=values: [_kernels.run_one(ks, v, ks.outputs) for _ in range(REPS)])
+            / reps
+        )
         out[f"{name} per scene (plain Python)"] = {
-            "jacobian_us": 1e6 * t_jac, "value_us": 1e6 * t_val, "ratio": t_jac / t_val,
-            "jacobian_outputs": len(jac.outputs)}
+            "jacobian_us": 1e6 * t_jac,
+            "value_us": 1e6 * t_val,
+            "ratio": t_jac / t_val,
+            "jacobian_outputs": len(jac.outputs),
+        }
     rng = np.random.default_rng(1)
     cols = {k: v for k, v in point.items() if k in _kernels.JACOBIAN["particle"].inputs}
     cols["v1x"] = 20 + rng.standard_normal(rows)
@@ -124,8 +160,13 @@ def jacobian_vs_value(rows: int = 200_000) -> dict:
     batch.run_columns(val, cols, val.outputs)
     t_jac = _best(lambda: batch.run_columns(jac, cols, jac.outputs))
     t_val = _best(lambda: batch.run_columns(val, cols, val.outputs))
-    out["particle batch (numba, parallel)"] = {"rows": rows, "jacobian_s": t_jac, "value_s": t_val,
-                                               "ratio": t_jac / t_val, "first_call_s": compile_s}
+    out["particle batch (numba, parallel)"] = {
+        "rows": rows,
+        "jacobian_s": t_jac,
+        "value_s": t_val,
+        "ratio": t_jac / t_val,
+        "first_call_s": compile_s,
+    }
     return out
 
 
@@ -144,10 +185,15 @@ def stream_memory(draws: int) -> dict:
     """Peak RSS [MB] of a child streaming `draws` draws, and of one with one chunk."""
     out = {}
     for label, n in (("one_chunk", 1 << 18), ("stream", draws)):
-        text = subprocess.run([sys.executable, "-c", CHILD.format(draws=n)], check=True,
-                              capture_output=True, text=True).stdout.split()
-        out[label] = {"draws": n, "peak_rss_mb": float(text[0]), "seconds": float(text[1]),
-                      "accepted": int(text[2])}
+        text = subprocess.run(
+            [sys.executable, "-c", CHILD.format(draws=n)], check=True, capture_output=True, text=True
+        ).stdout.split()
+        out[label] = {
+            "draws": n,
+            "peak_rss_mb": float(text[0]),
+            "seconds": float(text[1]),
+            "accepted": int(text[2]),
+        }
     out["ratio"] = out["stream"]["peak_rss_mb"] / out["one_chunk"]["peak_rss_mb"]
     return out
 

@@ -15,8 +15,17 @@ import os
 import sys
 from pathlib import Path
 
-MODEL_MODULES = ("particle", "planar", "delta_v", "inverse", "reconstruct", "presets", "crash3", "report",
-                 "jacobian")
+MODEL_MODULES = (
+    "particle",
+    "planar",
+    "delta_v",
+    "inverse",
+    "reconstruct",
+    "presets",
+    "crash3",
+    "report",
+    "jacobian",
+)
 # Proved before emission but emitting no module of their own (emit inlines their source).
 PROOF_ONLY_MODULES = ("trig",)
 ROOT = Path(__file__).resolve().parent.parent
@@ -42,8 +51,9 @@ def render_all() -> dict[str, str]:
         mod = importlib.import_module(f"derive.{name}")
         doc = (mod.__doc__ or "").strip().splitlines()[0]
         kernels = getattr(mod, "EMITTED", mod.KERNELS)
-        files[f"{name}.py"] = emit.render_module(f"{name}.py", doc, kernels, digest,
-                                                 data=getattr(mod, "DATA", ()))
+        files[f"{name}.py"] = emit.render_module(
+            f"{name}.py", doc, kernels, digest, data=getattr(mod, "DATA", ())
+        )
         files[f"{name}_jit.py"] = emit.render_jit_module(f"{name}.py", kernels, digest)
     files["codes.py"] = emit.render_codes(digest)
     files["__init__.py"] = emit.render_init(MODEL_MODULES, digest)
@@ -70,17 +80,23 @@ def stale_files(out: Path) -> dict[str, str]:
         path = out / name
         old = path.read_text() if path.exists() else ""
         if old != text:
-            stale[name] = "".join(difflib.unified_diff(
-                old.splitlines(keepends=True), text.splitlines(keepends=True),
-                fromfile=f"{path} (committed)", tofile=f"{path} (fresh render)"))
+            stale[name] = "".join(
+                difflib.unified_diff(
+                    old.splitlines(keepends=True),
+                    text.splitlines(keepends=True),
+                    fromfile=f"{path} (committed)",
+                    tofile=f"{path} (fresh render)",
+                )
+            )
     return stale
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m derive", description=__doc__.splitlines()[0])
     parser.add_argument("--check", action="store_true", help="print a diff and exit 1 if generated/ is stale")
-    parser.add_argument("--out", type=Path, default=ROOT / "generated",
-                        help="output folder (default: generated/)")
+    parser.add_argument(
+        "--out", type=Path, default=ROOT / "generated", help="output folder (default: generated/)"
+    )
     args = parser.parse_args(argv)
     if args.check:
         stale = stale_files(args.out)

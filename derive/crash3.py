@@ -86,8 +86,7 @@ def segment_energy():
 def profile_energy(n: int):
     """Crush energy of an n-point profile (segments of width L/(n - 1))."""
     seg = segment_energy()
-    return sum(seg.xreplace({Ca: DEPTHS[i], Cb: DEPTHS[i + 1], d: width / (n - 1)})
-               for i in range(n - 1))
+    return sum(seg.xreplace({Ca: DEPTHS[i], Cb: DEPTHS[i + 1], d: width / (n - 1)}) for i in range(n - 1))
 
 
 alpha_c, E_woolley = real("alpha_c E_woolley")
@@ -98,19 +97,24 @@ def energy_kernel(n: int) -> Kernel:
     with CRASH3's (E) and Woolley's (E_woolley) oblique corrections at the
     capped angle alpha_c = min(|α|, 45°)."""
     depths = DEPTHS[:n]
-    valid = (sp.GreaterThan(A, 0), sp.StrictGreaterThan(B, 0), sp.StrictGreaterThan(width, 0)) \
-        + tuple(sp.GreaterThan(ci, 0) for ci in depths)
+    valid = (sp.GreaterThan(A, 0), sp.StrictGreaterThan(B, 0), sp.StrictGreaterThan(width, 0)) + tuple(
+        sp.GreaterThan(ci, 0) for ci in depths
+    )
     return Kernel(
         name=f"crash3_energy_{n}",
         doc=f"CRASH3 crush energy of a {n}-point profile, F/w = A + B*C; E = E_crush*(1 + tan^2 "
-            "alpha_c), E_woolley = E_crush/cos(alpha_c), alpha_c = min(|alpha|, 45 deg).",
+        "alpha_c), E_woolley = E_crush/cos(alpha_c), alpha_c = min(|alpha|, 45 deg).",
         inputs=(A, B, width, *depths, alpha),
-        checks=(finite_inputs((A, B, width, *depths, alpha)), Guard(valid, "BAD_CRUSH"),
-                Guard((sp.StrictLessThan(sp.Abs(alpha), PDOF_LIMIT),), "PDOF_BEYOND_LIMIT")),
-        blocks=(Block(((G, A**2 / (2 * B)), (alpha_c, sp.Min(sp.Abs(alpha), PDOF_CAP)))),
-                Block(((E_crush, profile_energy(n)),)),
-                Block(((E, E_crush * (1 + sp.tan(alpha_c)**2)),
-                       (E_woolley, E_crush / sp.cos(alpha_c))))),
+        checks=(
+            finite_inputs((A, B, width, *depths, alpha)),
+            Guard(valid, "BAD_CRUSH"),
+            Guard((sp.StrictLessThan(sp.Abs(alpha), PDOF_LIMIT),), "PDOF_BEYOND_LIMIT"),
+        ),
+        blocks=(
+            Block(((G, A**2 / (2 * B)), (alpha_c, sp.Min(sp.Abs(alpha), PDOF_CAP)))),
+            Block(((E_crush, profile_energy(n)),)),
+            Block(((E, E_crush * (1 + sp.tan(alpha_c) ** 2)), (E_woolley, E_crush / sp.cos(alpha_c)))),
+        ),
         outputs=(E_crush, E, E_woolley),
         flags=(("PDOF_CAPPED", (sp.StrictGreaterThan(sp.Abs(alpha), PDOF_CAP),)),),
     )
@@ -122,7 +126,8 @@ rg1, rg2, h1, h2, alpha1, alpha2 = real("rg1 rg2 h1 h2 alpha1 alpha2")
 rx, ry, theta, mass, inertia, rg = real("rx ry theta mass inertia rg")
 ke1, ke2, ome, P, dV1, dV2 = real("ke1 ke2 one_minus_e P dV1 dV2")
 dV1x, dV1y, dV2x, dV2y, mass_factor1, mass_factor2, h = real(
-    "dV1x dV1y dV2x dV2y mass_factor1 mass_factor2 h")
+    "dV1x dV1y dV2x dV2y mass_factor1 mass_factor2 h"
+)
 dV1_eff, dV2_eff = real("dV1_eff dV2_eff")
 ENERGY_MODES = ("dissipated", "absorbed")
 pdof = sp.Symbol("pdof", real=True)
@@ -136,36 +141,53 @@ def delta_v_kernel(energy: str = "dissipated") -> Kernel:
     if energy == "dissipated":
         name, e_range = "crash3_delta_v", sp.StrictLessThan(e, 1)
         impulse = sp.sqrt(2 * E * (1 + e) / (ome * (ke1 + ke2)))
-        doc = ("CRASH3 delta-V from the total crush energy E dissipated over the impact: 1-D "
-               "impact of effective masses gamma_i*m_i along the PDOF, restitution e "
-               "(0 = common velocity).")
+        doc = (
+            "CRASH3 delta-V from the total crush energy E dissipated over the impact: 1-D "
+            "impact of effective masses gamma_i*m_i along the PDOF, restitution e "
+            "(0 = common velocity)."
+        )
     else:
         name, e_range = "crash3_delta_v_absorbed", sp.LessThan(e, 1)
         impulse = (1 + e) * sp.sqrt(2 * E / (ke1 + ke2))
-        doc = ("CRASH3 delta-V from the crush energy E absorbed up to maximum crush: approach "
-               "impulse sqrt(2 E mbar), total (1 + e) times it (Rose et al., SAE 2006-01-0908).")
+        doc = (
+            "CRASH3 delta-V from the crush energy E absorbed up to maximum crush: approach "
+            "impulse sqrt(2 E mbar), total (1 + e) times it (Rose et al., SAE 2006-01-0908)."
+        )
     return Kernel(
         name=name,
         doc=doc,
         inputs=(m1, m2, rg1, rg2, h1, h2, E, e, gamma, alpha1, alpha2),
-        checks=(finite_inputs((h1, h2, E, e, gamma, alpha1, alpha2), (m1, m2, rg1, rg2)),
-                positive_or_fixed((m1, m2, rg1, rg2)),
-                Guard((sp.GreaterThan(E, 0), sp.GreaterThan(e, 0), e_range),
-                      "ENERGY_INCONSISTENT")),
+        checks=(
+            finite_inputs((h1, h2, E, e, gamma, alpha1, alpha2), (m1, m2, rg1, rg2)),
+            positive_or_fixed((m1, m2, rg1, rg2)),
+            Guard((sp.GreaterThan(E, 0), sp.GreaterThan(e, 0), e_range), "ENERGY_INCONSISTENT"),
+        ),
         blocks=(
-            Block(f.inverse_masses((m1, m2), (k1, k2))
-                  + ((mass_factor1, 1 / (1 + (h1 / rg1)**2)),
-                     (mass_factor2, 1 / (1 + (h2 / rg2)**2)), (ome, 1 - e))),
+            Block(
+                f.inverse_masses((m1, m2), (k1, k2))
+                + (
+                    (mass_factor1, 1 / (1 + (h1 / rg1) ** 2)),
+                    (mass_factor2, 1 / (1 + (h2 / rg2) ** 2)),
+                    (ome, 1 - e),
+                )
+            ),
             # 1/(γ m) = (1/m)(1 + h²/k²): exactly 0 for a fixed body.
-            Block(((ke1, k1 * (1 + (h1 / rg1)**2)), (ke2, k2 * (1 + (h2 / rg2)**2))),
-                  Guard((sp.StrictGreaterThan(ke1 + ke2, 0),), "SINGULAR")),
+            Block(
+                ((ke1, k1 * (1 + (h1 / rg1) ** 2)), (ke2, k2 * (1 + (h2 / rg2) ** 2))),
+                Guard((sp.StrictGreaterThan(ke1 + ke2, 0),), "SINGULAR"),
+            ),
             Block(((P, impulse),)),
             Block(((dV1, k1 * P), (dV2, k2 * P), (dV1_eff, ke1 * P), (dV2_eff, ke2 * P))),
-            Block(((dV1x, -dV1 * sp.cos(gamma + alpha1)), (dV1y, -dV1 * sp.sin(gamma + alpha1)),
-                   (dV2x, dV2 * sp.cos(gamma + alpha2)), (dV2y, dV2 * sp.sin(gamma + alpha2)))),
+            Block(
+                (
+                    (dV1x, -dV1 * sp.cos(gamma + alpha1)),
+                    (dV1y, -dV1 * sp.sin(gamma + alpha1)),
+                    (dV2x, dV2 * sp.cos(gamma + alpha2)),
+                    (dV2y, dV2 * sp.sin(gamma + alpha2)),
+                )
+            ),
         ),
-        outputs=(P, dV1, dV2, mass_factor1, mass_factor2, dV1x, dV1y, dV2x, dV2y,
-                 dV1_eff, dV2_eff),
+        outputs=(P, dV1, dV2, mass_factor1, mass_factor2, dV1x, dV1y, dV2x, dV2y, dV1_eff, dV2_eff),
     )
 
 
@@ -209,44 +231,95 @@ def implied_pdof_kernel() -> Kernel:
 
 
 KERNELS = tuple(energy_kernel(n) for n in PROFILE_SIZES) + (
-    delta_v_kernel(), moment_arm_kernel(), radius_of_gyration_kernel(), implied_pdof_kernel(),
-    delta_v_kernel("absorbed"))
+    delta_v_kernel(),
+    moment_arm_kernel(),
+    radius_of_gyration_kernel(),
+    implied_pdof_kernel(),
+    delta_v_kernel("absorbed"),
+)
 
 
 # ---------------------------------------------------------------- proofs
+
 
 def published_six_point():
     """The CRASH3 manual's six-point crush energy, as printed there:
     (L/5)[A/2 (C1 + 2C2 + 2C3 + 2C4 + 2C5 + C6) + B/6 (C1² + 2C2² + 2C3² + 2C4²
     + 2C5² + C6² + C1C2 + C2C3 + C3C4 + C4C5 + C5C6) + 5G]."""
     C = DEPTHS
-    return width / 5 * (
-        A / 2 * (C[0] + 2 * C[1] + 2 * C[2] + 2 * C[3] + 2 * C[4] + C[5])
-        + B / 6 * (C[0]**2 + 2 * C[1]**2 + 2 * C[2]**2 + 2 * C[3]**2 + 2 * C[4]**2 + C[5]**2
-                   + C[0] * C[1] + C[1] * C[2] + C[2] * C[3] + C[3] * C[4] + C[4] * C[5])
-        + 5 * G)
+    return (
+        width
+        / 5
+        * (
+            A / 2 * (C[0] + 2 * C[1] + 2 * C[2] + 2 * C[3] + 2 * C[4] + C[5])
+            + B
+            / 6
+            * (
+                C[0] ** 2
+                + 2 * C[1] ** 2
+                + 2 * C[2] ** 2
+                + 2 * C[3] ** 2
+                + 2 * C[4] ** 2
+                + C[5] ** 2
+                + C[0] * C[1]
+                + C[1] * C[2]
+                + C[2] * C[3]
+                + C[3] * C[4]
+                + C[4] * C[5]
+            )
+            + 5 * G
+        )
+    )
 
 
 def _energy_claims():
     g_value = A**2 / (2 * B)
     density = energy_density()
-    out = [("crash3: energy density = A C + B C^2/2 + G = (A + B C)^2/(2B), G = A^2/(2B) "
+    out = [
+        (
+            "crash3: energy density = A C + B C^2/2 + G = (A + B C)^2/(2B), G = A^2/(2B) "
             "the work below zero crush",
             sp.simplify(density - (A * Ca + B * Ca**2 / 2 + g_value)) == 0
-            and sp.simplify(density - (A + B * Ca)**2 / (2 * B)) == 0
-            and sp.simplify(sp.integrate(A + B * c, (c, -A / B, 0)) - g_value) == 0)]
+            and sp.simplify(density - (A + B * Ca) ** 2 / (2 * B)) == 0
+            and sp.simplify(sp.integrate(A + B * c, (c, -A / B, 0)) - g_value) == 0,
+        )
+    ]
     energies = {n: KERNELS[i].expanded(E_crush, frozenset({G})) for i, n in enumerate(PROFILE_SIZES)}
-    out.append(("crash3: the 6-point energy equals the CRASH3 manual's formula",
-                sp.expand(energies[6] - published_six_point()) == 0))
-    out.append(("crash3: the 2-point energy is L [A (C1 + C2)/2 + B (C1^2 + C1 C2 + C2^2)/6 + G]",
-                sp.expand(energies[2] - width * (
+    out.append(
+        (
+            "crash3: the 6-point energy equals the CRASH3 manual's formula",
+            sp.expand(energies[6] - published_six_point()) == 0,
+        )
+    )
+    out.append(
+        (
+            "crash3: the 2-point energy is L [A (C1 + C2)/2 + B (C1^2 + C1 C2 + C2^2)/6 + G]",
+            sp.expand(
+                energies[2]
+                - width
+                * (
                     A * (DEPTHS[0] + DEPTHS[1]) / 2
-                    + B * (DEPTHS[0]**2 + DEPTHS[0] * DEPTHS[1] + DEPTHS[1]**2) / 6 + G)) == 0))
+                    + B * (DEPTHS[0] ** 2 + DEPTHS[0] * DEPTHS[1] + DEPTHS[1] ** 2) / 6
+                    + G
+                )
+            )
+            == 0,
+        )
+    )
     uniform = sp.Symbol("C", nonnegative=True)
-    out.append(("crash3: a uniform crush C gives L (A C + B C^2/2 + G) for 2, 4 and 6 points",
-                all(sp.expand(energies[n].xreplace({ci: uniform for ci in DEPTHS})
-                              - width * (A * uniform + B * uniform**2 / 2 + G)) == 0
-                    for n in PROFILE_SIZES)))
+    out.append(
+        (
+            "crash3: a uniform crush C gives L (A C + B C^2/2 + G) for 2, 4 and 6 points",
+            all(
+                sp.expand(
+                    energies[n].xreplace({ci: uniform for ci in DEPTHS})
+                    - width * (A * uniform + B * uniform**2 / 2 + G)
+                )
+                == 0
+                for n in PROFILE_SIZES
+            ),
+        )
+    )
     out += _correction_claims()
     return out
 
@@ -260,20 +333,32 @@ def _correction_claims():
     ok_below = ok_cap = True
     for knl in KERNELS[:3]:
         crash, woolley = (knl.expanded(x, frozenset({E_crush})) for x in (E, E_woolley))
-        ok_below &= sp.simplify(crash.xreplace(below) - E_crush / sp.cos(alpha)**2) == 0 \
-            and sp.simplify(woolley.xreplace(below) - E_crush / sp.cos(alpha)) == 0 \
+        ok_below &= (
+            sp.simplify(crash.xreplace(below) - E_crush / sp.cos(alpha) ** 2) == 0
+            and sp.simplify(woolley.xreplace(below) - E_crush / sp.cos(alpha)) == 0
             and sp.simplify(woolley.xreplace(below) / crash.xreplace(below) - sp.cos(alpha)) == 0
-        ok_cap &= sp.simplify(crash.xreplace(cap) - 2 * E_crush) == 0 \
+        )
+        ok_cap &= (
+            sp.simplify(crash.xreplace(cap) - 2 * E_crush) == 0
             and sp.simplify(woolley.xreplace(cap) - sp.sqrt(2) * E_crush) == 0
+        )
     capped = KERNELS[0].expanded(alpha_c)
-    samples = {sp.Rational(3, 10): sp.Rational(3, 10), -sp.Rational(3, 10): sp.Rational(3, 10),
-               sp.Rational(6, 5): PDOF_CAP, -sp.Rational(6, 5): PDOF_CAP}
+    samples = {
+        sp.Rational(3, 10): sp.Rational(3, 10),
+        -sp.Rational(3, 10): sp.Rational(3, 10),
+        sp.Rational(6, 5): PDOF_CAP,
+        -sp.Rational(6, 5): PDOF_CAP,
+    }
     ok_clamp = all(capped.xreplace({alpha: a}) == want for a, want in samples.items())
-    return [("crash3: below the cap E = E_crush/cos^2(alpha) (CRASH3) and E_woolley = "
-             "E_crush/cos(alpha) = cos(alpha) E (Woolley)", ok_below),
-            ("crash3: at the EDCRASH cap (45 deg) E = 2 E_crush and E_woolley = sqrt(2) E_crush",
-             ok_cap),
-            ("crash3: the corrected angle is min(|alpha|, 45 deg)", ok_clamp)]
+    return [
+        (
+            "crash3: below the cap E = E_crush/cos^2(alpha) (CRASH3) and E_woolley = "
+            "E_crush/cos(alpha) = cos(alpha) E (Woolley)",
+            ok_below,
+        ),
+        ("crash3: at the EDCRASH cap (45 deg) E = 2 E_crush and E_woolley = sqrt(2) E_crush", ok_cap),
+        ("crash3: the corrected angle is min(|alpha|, 45 deg)", ok_clamp),
+    ]
 
 
 def _one_dimensional_impulse():
@@ -281,10 +366,11 @@ def _one_dimensional_impulse():
     ke2) closing at speed vc, with restitution e, solved by SymPy from momentum
     and restitution."""
     u1, U1, U2, vc = real("u1 U1 U2 vc")
-    sol = sp.solve([U1 / ke1 + U2 / ke2 - (u1 / ke1 + (u1 - vc) / ke2),
-                    (U2 - U1) - e * vc], [U1, U2], dict=True)[0]
+    sol = sp.solve(
+        [U1 / ke1 + U2 / ke2 - (u1 / ke1 + (u1 - vc) / ke2), (U2 - U1) - e * vc], [U1, U2], dict=True
+    )[0]
     impulse = (u1 - sol[U1]) / ke1
-    lost = (u1**2 / ke1 + (u1 - vc)**2 / ke2 - sol[U1]**2 / ke1 - sol[U2]**2 / ke2) / 2
+    lost = (u1**2 / ke1 + (u1 - vc) ** 2 / ke2 - sol[U1] ** 2 / ke1 - sol[U2] ** 2 / ke2) / 2
     return sp.simplify(impulse), sp.simplify(lost), vc
 
 
@@ -293,8 +379,13 @@ def _delta_v_claims():
     p_kernel = knl.expanded(P, frozenset({ke1, ke2}))
     impulse, lost, vc = _one_dimensional_impulse()
     one_d = sp.simplify(p_kernel**2 - impulse**2).xreplace({E: lost})
-    out = [("crash3_delta_v: |P| is the impulse of the 1-D impact of effective masses "
-            "with energy loss E and restitution e", sp.simplify(one_d) == 0)]
+    out = [
+        (
+            "crash3_delta_v: |P| is the impulse of the 1-D impact of effective masses "
+            "with energy loss E and restitution e",
+            sp.simplify(one_d) == 0,
+        )
+    ]
     # Effective mass: the velocity change of the impact centre along d per unit
     # impulse is 1/m + (r × d)^2/I, i.e. (1/m)(1 + h^2/k^2) with I = m k^2.
     # Unit direction d = (nx, ny) (frame's symbols, so reduce_unit_normal applies).
@@ -304,21 +395,39 @@ def _delta_v_claims():
     along = (point.T * d_vec)[0]
     arm = moment_arm_kernel().expanded(h).xreplace({sp.sin(theta): f.ny, sp.cos(theta): f.nx})
     effective = knl.expanded(ke1, frozenset({k1})).xreplace({k1: 1 / mass_i, rg1: rg_i, h1: arm})
-    out.append(("crash3_delta_v: 1/(gamma m) = 1/m + h^2/I is the impact centre's compliance "
-                "along the PDOF, h = r x d, gamma = k^2/(k^2 + h^2)",
-                f.reduce_unit_normal(along - effective) == 0
-                and sp.simplify(knl.expanded(mass_factor1) - rg1**2 / (rg1**2 + h1**2)) == 0))
-    out.append(("crash3_delta_v: m1 dV1 = m2 dV2, and with equal PDOFs the vectors conserve "
-                "momentum", _momentum_claim(knl)))
-    out.append(("crash3_delta_v: the CG delta-V is gamma times the effective-mass delta-V "
-                "(dV_i = gamma_i dV_i_eff, dV_i_eff = |P|/(gamma_i m_i))",
-                all(sp.simplify(kn.expanded(dV - mf * dv_eff, frozenset({P}))) == 0
-                    for kn in (knl, KERNELS[7])
-                    for dV, mf, dv_eff in ((dV1, mass_factor1, dV1_eff),
-                                           (dV2, mass_factor2, dV2_eff)))))
+    out.append(
+        (
+            "crash3_delta_v: 1/(gamma m) = 1/m + h^2/I is the impact centre's compliance "
+            "along the PDOF, h = r x d, gamma = k^2/(k^2 + h^2)",
+            f.reduce_unit_normal(along - effective) == 0
+            and sp.simplify(knl.expanded(mass_factor1) - rg1**2 / (rg1**2 + h1**2)) == 0,
+        )
+    )
+    out.append(
+        (
+            "crash3_delta_v: m1 dV1 = m2 dV2, and with equal PDOFs the vectors conserve momentum",
+            _momentum_claim(knl),
+        )
+    )
+    out.append(
+        (
+            "crash3_delta_v: the CG delta-V is gamma times the effective-mass delta-V "
+            "(dV_i = gamma_i dV_i_eff, dV_i_eff = |P|/(gamma_i m_i))",
+            all(
+                sp.simplify(kn.expanded(dV - mf * dv_eff, frozenset({P}))) == 0
+                for kn in (knl, KERNELS[7])
+                for dV, mf, dv_eff in ((dV1, mass_factor1, dV1_eff), (dV2, mass_factor2, dV2_eff))
+            ),
+        )
+    )
     out += _absorbed_claims(knl, impulse, lost)
-    out.append(("crash3_delta_v: given the common-velocity rigid solution's PDOF and energy "
-                "loss it returns that solution's |P| exactly", _common_velocity_claim(knl)))
+    out.append(
+        (
+            "crash3_delta_v: given the common-velocity rigid solution's PDOF and energy "
+            "loss it returns that solution's |P| exactly",
+            _common_velocity_claim(knl),
+        )
+    )
     return out
 
 
@@ -331,14 +440,20 @@ def _absorbed_claims(dissipated: Kernel, impulse, lost):
     knl = KERNELS[7]
     p_abs = knl.expanded(P, frozenset({ke1, ke2}))
     approach_loss = lost.xreplace({e: 0})
-    full = sp.simplify(p_abs.xreplace({E: approach_loss})**2 - impulse**2)
+    full = sp.simplify(p_abs.xreplace({E: approach_loss}) ** 2 - impulse**2)
     total = sp.simplify(impulse - (1 + e) * impulse.xreplace({e: 0}))
     ratio = p_abs / dissipated.expanded(P, frozenset({ke1, ke2}))
-    return [("crash3_delta_v_absorbed: with E the energy absorbed to maximum crush, |P| is the "
-             "1-D impulse with restitution e, (1 + e) times the approach impulse",
-             full == 0 and total == 0),
-            ("crash3_delta_v_absorbed: for the same E, |P|_absorbed = sqrt(1 - e^2) "
-             "|P|_dissipated", sp.simplify(ratio**2 - (1 - e**2)) == 0)]
+    return [
+        (
+            "crash3_delta_v_absorbed: with E the energy absorbed to maximum crush, |P| is the "
+            "1-D impulse with restitution e, (1 + e) times the approach impulse",
+            full == 0 and total == 0,
+        ),
+        (
+            "crash3_delta_v_absorbed: for the same E, |P|_absorbed = sqrt(1 - e^2) |P|_dissipated",
+            sp.simplify(ratio**2 - (1 - e**2)) == 0,
+        ),
+    ]
 
 
 def _momentum_claim(knl: Kernel) -> bool:
@@ -356,14 +471,18 @@ def _common_velocity_claim(knl: Kernel) -> bool:
     |P|² (k1 + k2) + j1 (r1 × P)² + j2 (r2 × P)²; along d = P/|P| the kernel's
     effective compliance is ke1 + ke2 = PᵀKP/|P|², and 2 T_L/(ke1 + ke2) = |P|²."""
     r1n, r1t, r2n, r2t = planar.r1n, planar.r1t, planar.r2n, planar.r2t
-    keff = {s: x.xreplace({planar.wa: j1, planar.wb: j2, planar.wc: 0, planar.kk: k1 + k2})
-            for s, x in planar.effective_compliance().items()}
+    keff = {
+        s: x.xreplace({planar.wa: j1, planar.wb: j2, planar.wc: 0, planar.kk: k1 + k2})
+        for s, x in planar.effective_compliance().items()
+    }
     Kmat = sp.Matrix([[keff[planar.Knn], keff[planar.Knt]], [keff[planar.Knt], keff[planar.Ktt]]])
     vec = sp.Matrix([Pn, Pt])
     quad = sp.expand((vec.T * Kmat * vec)[0])
     size = Pn**2 + Pt**2
-    arms = {h1: planar._cross(r1n, r1t, Pn, Pt) / sp.sqrt(size),
-            h2: planar._cross(r2n, r2t, Pn, Pt) / sp.sqrt(size)}
+    arms = {
+        h1: planar._cross(r1n, r1t, Pn, Pt) / sp.sqrt(size),
+        h2: planar._cross(r2n, r2t, Pn, Pt) / sp.sqrt(size),
+    }
     # k_i (1 + h_i²/rg_i²) with rg_i² = 1/(m_i j_i) = k_i/j_i: k_i + j_i h_i².
     inertia = {rg1: sp.sqrt(k1 / j1), rg2: sp.sqrt(k2 / j2)}
     p2 = knl.expanded(P, frozenset({k1, k2})).xreplace({e: 0}).xreplace(inertia).xreplace(arms) ** 2
@@ -377,11 +496,14 @@ def _implied_pdof_claim():
     force = [-size * sp.cos(gamma + a), -size * sp.sin(gamma + a)]
     impulse = f.to_scene_frame(Pn, Pt)
     n_t = {f.nx: sp.cos(gamma), f.ny: sp.sin(gamma)}
-    same = all(sp.simplify(sp.expand_trig(fc) - ic.xreplace(n_t)) == 0
-               for fc, ic in zip(force, impulse))
-    return [("crash3_implied_pdof: the force on vehicle 1 is -|P| (cos(G + alpha), "
-             "sin(G + alpha)) and tan(alpha) = Pt/Pn = mu", same
-             and sp.simplify(sp.tan(a) - Pt / Pn) == 0)]
+    same = all(sp.simplify(sp.expand_trig(fc) - ic.xreplace(n_t)) == 0 for fc, ic in zip(force, impulse))
+    return [
+        (
+            "crash3_implied_pdof: the force on vehicle 1 is -|P| (cos(G + alpha), "
+            "sin(G + alpha)) and tan(alpha) = Pt/Pn = mu",
+            same and sp.simplify(sp.tan(a) - Pt / Pn) == 0,
+        )
+    ]
 
 
 def proofs():

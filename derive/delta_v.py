@@ -39,17 +39,19 @@ def _blocks():
     r1n_, r1t_ = f.to_impact_frame(r1x, r1y)
     r2n_, r2t_ = f.to_impact_frame(r2x, r2y)
     return (
-        Block(f.inverse_masses((m1, m2, I1, I2), (k1, k2, j1, j2)) + f.normal_components(),
-              Guard((sp.StrictGreaterThan(k1 + k2, 0),), "SINGULAR")),
+        Block(
+            f.inverse_masses((m1, m2, I1, I2), (k1, k2, j1, j2)) + f.normal_components(),
+            Guard((sp.StrictGreaterThan(k1 + k2, 0),), "SINGULAR"),
+        ),
         Block(((r1n, r1n_), (r1t, r1t_), (r2n, r2n_), (r2t, r2t_))),
         Block(((Cnn, C[0, 0]), (Cnt, C[0, 1]), (Ctt, C[1, 1]))),
         # 1 - e as one rounded quantity (SymPy would flatten it into the sum).
-        Block(((D, Cnn + mu * Cnt), (ome, 1 - e)),
-              Guard((sp.Ne(D, 0),), "SINGULAR")),
-        Block(((q, (k1 + k2) / D),
-               (B, ome + 2 * mu * r - mu * (1 + e) * (Cnt + mu * Ctt) / D)),
-              # T_L = Pn² D B / (2(1 + e)): a real |P| needs D·B > 0.
-              Guard((sp.StrictGreaterThan(D * B, 0),), "ENERGY_INCONSISTENT")),
+        Block(((D, Cnn + mu * Cnt), (ome, 1 - e)), Guard((sp.Ne(D, 0),), "SINGULAR")),
+        Block(
+            ((q, (k1 + k2) / D), (B, ome + 2 * mu * r - mu * (1 + e) * (Cnt + mu * Ctt) / D)),
+            # T_L = Pn² D B / (2(1 + e)): a real |P| needs D·B > 0.
+            Guard((sp.StrictGreaterThan(D * B, 0),), "ENERGY_INCONSISTENT"),
+        ),
         Block(((P_abs, sp.sqrt(2 * (1 + mu**2) * (1 + e) * TL_in / (D * B))),)),
         Block(((dV1, k1 * P_abs), (dV2, k2 * P_abs))),
     )
@@ -60,10 +62,11 @@ KERNELS = (
         name="delta_v_from_energy",
         doc="Delta-V of each vehicle from the energy loss TL (seed eqs 27-29; e_m = 1).",
         inputs=INPUTS,
-        checks=(finite_inputs((r1x, r1y, r2x, r2y, gamma, e, mu, r, TL_in), (m1, m2, I1, I2)),
-                positive_or_fixed((m1, m2, I1, I2)),
-                Guard((sp.GreaterThan(TL_in, 0), sp.StrictGreaterThan(1 + e, 0)),
-                      "ENERGY_INCONSISTENT")),
+        checks=(
+            finite_inputs((r1x, r1y, r2x, r2y, gamma, e, mu, r, TL_in), (m1, m2, I1, I2)),
+            positive_or_fixed((m1, m2, I1, I2)),
+            Guard((sp.GreaterThan(TL_in, 0), sp.StrictGreaterThan(1 + e, 0)), "ENERGY_INCONSISTENT"),
+        ),
         blocks=_blocks(),
         outputs=OUTPUTS,
     ),
@@ -71,6 +74,7 @@ KERNELS = (
 
 
 # ---------------------------------------------------------------- proofs
+
 
 def proofs():
     """The relation agrees with the forward rigid model (e_m = 1) and is eq 27
@@ -88,12 +92,18 @@ def proofs():
     central = {r1n: 0, r1t: 0, r2n: 0, r2t: 0}
     mbar = 1 / (k1 + k2)
     mu_max = r / (1 + e)
-    eq27 = (k1 * sp.sqrt(2 * mbar * (1 + mu**2) * (1 + e) * knl.expanded(q, atoms) * TL_in
-                         / ((1 - e) + 2 * mu * r - mu**2 * r / mu_max)))
+    eq27 = k1 * sp.sqrt(
+        2
+        * mbar
+        * (1 + mu**2)
+        * (1 + e)
+        * knl.expanded(q, atoms)
+        * TL_in
+        / ((1 - e) + 2 * mu * r - mu**2 * r / mu_max)
+    )
     is_eq27 = sp.simplify((knl.expanded(dV1, atoms) - eq27).xreplace(central)) == 0
     # Eq 29 with the seed's arms d_c = r1t, d_d = r1n, d_a = r2t, d_b = r2n.
-    eq29 = 1 + mbar * r2t**2 * j2 + mbar * r1t**2 * j1 - mu * (
-        mbar * r1t * r1n * j1 + mbar * r2t * r2n * j2)
+    eq29 = 1 + mbar * r2t**2 * j2 + mbar * r1t**2 * j1 - mu * (mbar * r1t * r1n * j1 + mbar * r2t * r2n * j2)
     is_eq29 = sp.simplify(1 / knl.expanded(q, atoms) - eq29) == 0
     dv2_ratio = sp.simplify(knl.expanded(dV2, atoms) - k2 / k1 * knl.expanded(dV1, atoms)) == 0
     return [

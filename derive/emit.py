@@ -69,8 +69,7 @@ class KernelPrinter(PythonCodePrinter):
         """As CodePrinter, except that a lone squared denominator keeps its
         parentheses: x/y**2 is printed x/(y*y), never x/y*y."""
         text = super()._print_Mul(expr)
-        dens = [a for a in sp.Mul.make_args(expr)
-                if a.is_Pow and a.exp.is_Rational and a.exp.is_negative]
+        dens = [a for a in sp.Mul.make_args(expr) if a.is_Pow and a.exp.is_Rational and a.exp.is_negative]
         if len(dens) == 1 and dens[0].exp == -2:
             square = self._print(sp.Pow(dens[0].base, 2, evaluate=False))
             if text.endswith("/" + square):
@@ -120,7 +119,7 @@ class Style:
 
     def jit(self, parallel: bool = False, inline: bool = False) -> str:
         extra = (", parallel=True" if parallel else "") + (', inline="always"' if inline else "")
-        return f"njit(cache=True, error_model=\"numpy\"{self.jit_options}{extra})"
+        return f'njit(cache=True, error_model="numpy"{self.jit_options}{extra})'
 
     def code(self, expr) -> str:
         """One expression as Python source."""
@@ -216,7 +215,7 @@ def program(kernel: Kernel, style: Style = DEFAULT) -> Program:
     operations = 0
     at = 0
     for block in kernel.blocks:
-        mine = reduced[at:at + len(block.assigns)]
+        mine = reduced[at : at + len(block.assigns)]
         at += len(block.assigns)
         needed = set().union(*(x.free_symbols for x in mine if x is not None))
         needed |= {sym for sym, x in zip((s for s, _ in block.assigns), mine) if x is None}
@@ -247,8 +246,9 @@ def _tidy(temps, reduced, kernel: Kernel):
     (Pn = bn/D, then Pt = Pn*mu): it is computed where the temporary would
     be, the first block that needs the value, and the named assignment goes
     (its entry in `reduced` becomes None)."""
-    inline = {t: x for t, x in temps if x.is_Mul and len(x.args) == 2 and x.args[0] == -1
-              and x.args[1].is_Symbol}
+    inline = {
+        t: x for t, x in temps if x.is_Mul and len(x.args) == 2 and x.args[0] == -1 and x.args[1].is_Symbol
+    }
     temps = [(t, x.xreplace(inline)) for t, x in temps if t not in inline]
     reduced = [x.xreplace(inline) for x in reduced]
     names = [sym for block in kernel.blocks for sym, _ in block.assigns]
@@ -257,8 +257,9 @@ def _tidy(temps, reduced, kernel: Kernel):
         if x in dict(temps) and x not in rename:
             rename[x] = sym
     temps = [(rename.get(t, t), x.xreplace(rename)) for t, x in temps]
-    reduced = [None if x in rename and rename[x] == sym else x.xreplace(rename)
-               for sym, x in zip(names, reduced)]
+    reduced = [
+        None if x in rename and rename[x] == sym else x.xreplace(rename) for sym, x in zip(names, reduced)
+    ]
     return temps, reduced
 
 
@@ -278,13 +279,16 @@ def _lines(prog: Program, ind: str, style: Style, straight: bool) -> list[str]:
             guard = step[1]
             if straight:
                 cond = " & ".join(f"({style.code(c)})" for c in guard.conditions)
-                lines += [f"{ind}if (status == 0) & (not ({cond})):",
-                          f"{ind}    status = {STATUS[guard.status]}  # {guard.status}"]
+                lines += [
+                    f"{ind}if (status == 0) & (not ({cond})):",
+                    f"{ind}    status = {STATUS[guard.status]}  # {guard.status}",
+                ]
             else:
                 cond = " and ".join(f"({style.code(c)})" for c in guard.conditions)
-                lines += [f"{ind}if not ({cond}):",
-                          f"{ind}    return _{name}_failed({STATUS[guard.status]})"
-                          f"  # {guard.status}"]
+                lines += [
+                    f"{ind}if not ({cond}):",
+                    f"{ind}    return _{name}_failed({STATUS[guard.status]})  # {guard.status}",
+                ]
         else:
             either = " | " if straight else " or "
             lines.append(f"{ind}flags = 0")
@@ -293,11 +297,15 @@ def _lines(prog: Program, ind: str, style: Style, straight: bool) -> list[str]:
                 lines += [f"{ind}if {cond}:", f"{ind}    flags |= {FLAGS[flag]}  # {flag}"]
     total = " + ".join(str(s) for s in prog.kernel.finite_checked())
     if straight:
-        lines += [f"{ind}if (status == 0) & (not math.isfinite({total})):",
-                  f"{ind}    status = {STATUS['OVERFLOW']}  # OVERFLOW"]
+        lines += [
+            f"{ind}if (status == 0) & (not math.isfinite({total})):",
+            f"{ind}    status = {STATUS['OVERFLOW']}  # OVERFLOW",
+        ]
     else:
-        lines += [f"{ind}if not math.isfinite({total}):",
-                  f"{ind}    return _{name}_failed({STATUS['OVERFLOW']})  # OVERFLOW"]
+        lines += [
+            f"{ind}if not math.isfinite({total}):",
+            f"{ind}    return _{name}_failed({STATUS['OVERFLOW']})  # OVERFLOW",
+        ]
     return lines
 
 
@@ -310,7 +318,7 @@ def column_names(kernel: Kernel) -> tuple[str, ...]:
     names = [str(s) for s in kernel.inputs]
     if kernel.angle is not None:
         at = names.index("nx")
-        names[at:at + 2] = [str(kernel.angle)]
+        names[at : at + 2] = [str(kernel.angle)]
     return tuple(names)
 
 
@@ -343,9 +351,12 @@ def scene_function(prog: Program, style: Style = DEFAULT) -> str:
     outs = ", ".join(str(s) for s in knl.outputs)
     ind = "    "
     lines = _wrap(f"def {knl.name}(", [str(s) for s in knl.inputs], "):", " " * 8)
-    lines += [f'{ind}"""{knl.doc}', "",
-              f"{ind}Returns ({outs}, status, flags); a failed row has NaN outputs.",
-              f'{ind}"""']
+    lines += [
+        f'{ind}"""{knl.doc}',
+        "",
+        f"{ind}Returns ({outs}, status, flags); a failed row has NaN outputs.",
+        f'{ind}"""',
+    ]
     lines += _lines(prog, ind, style, straight=False)
     lines.append(f"{ind}return ({outs}, 0, flags)")
     return "\n".join(lines) + "\n"
@@ -361,12 +372,14 @@ def unit_normal_function() -> str:
     """`unit_normal(gamma)` → (nx, ny): `_sincos` within SINCOS_LIMIT, math's
     cos/sin beyond (as the batch runtime does), NaN for a non-finite angle
     (which the kernels then reject as a non-finite input)."""
-    return ("def unit_normal(gamma):\n"
-            '    """The contact normal (nx, ny) of the angle gamma [rad]."""\n'
-            "    if not math.isfinite(gamma):\n        return (math.nan, math.nan)\n"
-            "    if abs(gamma) <= SINCOS_LIMIT:\n"
-            "        ny, nx = _sincos(gamma)\n        return (nx, ny)\n"
-            "    return (math.cos(gamma), math.sin(gamma))\n")
+    return (
+        "def unit_normal(gamma):\n"
+        '    """The contact normal (nx, ny) of the angle gamma [rad]."""\n'
+        "    if not math.isfinite(gamma):\n        return (math.nan, math.nan)\n"
+        "    if abs(gamma) <= SINCOS_LIMIT:\n"
+        "        ny, nx = _sincos(gamma)\n        return (nx, ny)\n"
+        "    return (math.cos(gamma), math.sin(gamma))\n"
+    )
 
 
 def _legend(kernels) -> list[str]:
@@ -390,10 +403,17 @@ def render_module(model_file: str, doc: str, kernels, digest: str, data=()) -> s
     progs = [program(k) for k in kernels]
     model = model_file.removesuffix(".py")
     total = sum(p.operations for p in progs)
-    parts = [header(model_file, digest).rstrip("\n"),
-             f"# {len(progs)} kernels, {total} arithmetic operations after common-subexpression "
-             "elimination;", f"# batch drivers: generated/{model}_jit.py.", *_legend(kernels),
-             "", f'"""{doc}"""', "", "import math", ""]
+    parts = [
+        header(model_file, digest).rstrip("\n"),
+        f"# {len(progs)} kernels, {total} arithmetic operations after common-subexpression elimination;",
+        f"# batch drivers: generated/{model}_jit.py.",
+        *_legend(kernels),
+        "",
+        f'"""{doc}"""',
+        "",
+        "import math",
+        "",
+    ]
     parts += ["MANIFEST = {"]
     for prog in progs:
         parts.append(f"    {prog.kernel.name!r}: {{")
@@ -407,8 +427,7 @@ def render_module(model_file: str, doc: str, kernels, digest: str, data=()) -> s
     for name, value in data:
         parts += [f"{name} = {pprint.pformat(value, width=WIDTH, sort_dicts=False)}", ""]
     if any(k.angle is not None for k in kernels):
-        parts += [f"SINCOS_LIMIT = {SINCOS_LIMIT!r}", "", "", SINCOS_SOURCE, "",
-                  unit_normal_function()]
+        parts += [f"SINCOS_LIMIT = {SINCOS_LIMIT!r}", "", "", SINCOS_SOURCE, "", unit_normal_function()]
     for prog in progs:
         parts += ["", failed_function(prog.kernel), "", scene_function(prog)]
     return "\n".join(parts).rstrip("\n") + "\n"
@@ -450,11 +469,14 @@ def driver_function(kernel: Kernel, parallel: bool, normal: bool, style: Style =
     outs = [f"out_{s}" for s in kernel.output_names()] + ["out_status", "out_flags"]
     ind = "        "
     lines = [f"@{style.jit(parallel)}"]
-    lines += _wrap(f"def {driver_name(kernel, parallel, normal)}(",
-                   [f"c_{c}" for c in columns] + outs, "):", " " * 8)
-    lines += [f'    """{"Parallel" if parallel else "Serial"} batch of `{kernel.name}`'
-              f'{", the angle per row" if angle else ""}."""',
-              f"    for i in {'prange' if parallel else 'range'}(out_status.shape[0]):"]
+    lines += _wrap(
+        f"def {driver_name(kernel, parallel, normal)}(", [f"c_{c}" for c in columns] + outs, "):", " " * 8
+    )
+    lines += [
+        f'    """{"Parallel" if parallel else "Serial"} batch of `{kernel.name}`'
+        f'{", the angle per row" if angle else ""}."""',
+        f"    for i in {'prange' if parallel else 'range'}(out_status.shape[0]):",
+    ]
     if angle:
         lines.append(f"{ind}ny, nx = _sincos(c_{kernel.angle}[i])")
     values = [a if angle and a in ("nx", "ny") else f"c_{a}[i]" for a in args]
@@ -467,14 +489,21 @@ def render_jit_module(model_file: str, kernels, digest: str, style: Style = DEFA
     """generated/<model>_jit.py as text: `_sincos`, and per kernel its body and
     drivers."""
     model = model_file.removesuffix(".py")
-    parts = [header(model_file, digest).rstrip("\n"), "",
-             f'"""Numba batch drivers of generated/{model}.py (see its MANIFEST and legend)."""',
-             "", *style.imports, "", "from numba import njit, prange", ""]
+    parts = [
+        header(model_file, digest).rstrip("\n"),
+        "",
+        f'"""Numba batch drivers of generated/{model}.py (see its MANIFEST and legend)."""',
+        "",
+        *style.imports,
+        "",
+        "from numba import njit, prange",
+        "",
+    ]
     if any(k.angle is not None for k in kernels):
         parts += ["", f"@{style.jit(inline=True)}", SINCOS_SOURCE]
     for knl in kernels:
         parts += ["", body_function(program(knl, style), style)]
-        for normal in ((False, True) if knl.angle is not None else (False,)):
+        for normal in (False, True) if knl.angle is not None else (False,):
             for parallel in (True, False):
                 parts += ["", driver_function(knl, parallel, normal, style)]
     return "\n".join(parts).rstrip("\n") + "\n"
@@ -490,8 +519,10 @@ def render_codes(digest: str) -> str:
 
 def render_init(modules, digest: str) -> str:
     """generated/__init__.py with the marker the runtime checks."""
-    return (header("emit.py", digest)
-            + '"""Kernels emitted by impactsym\'s derive step: <model>.py (plain Python) '
-            + 'and <model>_jit.py (numba)."""\n\n'
-            + 'IMPACTSYM_GENERATED = "impactsym"\n'
-            + f"MODULES = {tuple(modules)!r}\n")
+    return (
+        header("emit.py", digest)
+        + '"""Kernels emitted by impactsym\'s derive step: <model>.py (plain Python) '
+        + 'and <model>_jit.py (numba)."""\n\n'
+        + 'IMPACTSYM_GENERATED = "impactsym"\n'
+        + f"MODULES = {tuple(modules)!r}\n"
+    )

@@ -64,8 +64,9 @@ def delta_v_magnitudes_hold(expand) -> bool:
     (a kernel's formulas with Pn, Pt kept free), modulo nx² + ny² = 1."""
     pairs = ((dV1, V1x, V1y, v1x, v1y), (dV2, V2x, V2y, v2x, v2y))
     return all(
-        reduce_unit_normal(expand(dv)**2 - (expand(vx) - ix)**2 - (expand(vy) - iy)**2) == 0
-        for dv, vx, vy, ix, iy in pairs)
+        reduce_unit_normal(expand(dv) ** 2 - (expand(vx) - ix) ** 2 - (expand(vy) - iy) ** 2) == 0
+        for dv, vx, vy, ix, iy in pairs
+    )
 
 
 def to_impact_frame(ax, ay):
@@ -100,9 +101,13 @@ def physics_flags(energy_parts, work_terms, mu_used=mu_used):
     along -n). μ beyond critical: μ not between 0 and μ_c (either sign), by
     more than ROUNDING·|μ_c|.
     """
-    tolerances = Block(((tol_energy, ROUNDING * sum(sp.Abs(a * b) for a, b in work_terms)),
-                        (tol_mu, ROUNDING * sp.Abs(mu_c))),
-                       equation="tolerances of the physics flags (conventions.md)")
+    tolerances = Block(
+        (
+            (tol_energy, ROUNDING * sum(sp.Abs(a * b) for a, b in work_terms)),
+            (tol_mu, ROUNDING * sp.Abs(mu_c)),
+        ),
+        equation="tolerances of the physics flags (conventions.md)",
+    )
     return tolerances, (
         ("ENERGY_CREATED", tuple(sp.StrictLessThan(part, -tol_energy) for part in energy_parts)),
         ("TENSILE_IMPULSE", (sp.GreaterThan(Pn, 0),)),

@@ -84,8 +84,7 @@ PARTICLE_OUTPUTS = (v1x, v1y, v2x, v2y, Pn, Pt, mu_c, TL, TLn, TLt)
 def _coefficient_guards(rigid: bool):
     guards = [Guard((sp.GreaterThan(e, INVERSE_MIN),), "INVERSE_E_TOO_SMALL")]
     if rigid:
-        guards.append(Guard((sp.GreaterThan(sp.Abs(e_m), INVERSE_MIN),),
-                            "INVERSE_EM_TOO_SMALL"))
+        guards.append(Guard((sp.GreaterThan(sp.Abs(e_m), INVERSE_MIN),), "INVERSE_EM_TOO_SMALL"))
     return tuple(guards)
 
 
@@ -106,52 +105,103 @@ def _rigid_blocks():
     # motion is the final one plus C·(Pn, Pt, M).
     gn_ = -Gn / e
     return (
-        Block(f.inverse_masses((m1, m2, I1, I2), (k1, k2, j1, j2)) + f.normal_components()
-              + ((dVx, V2x - V1x), (dVy, V2y - V1y), (Wr, W2 - W1),
-                 (drx, r1x - r2x), (dry, r1y - r2y)),
-              Guard((sp.StrictGreaterThan(k1 + k2, 0), sp.StrictGreaterThan(j1 + j2, 0)),
-                    "SINGULAR")),
-        Block(((r1n, r1n_), (r1t, r1t_), (r2n, r2n_), (r2t, r2t_), (Gx, final_rel[0]),
-               (Gy, final_rel[1]), (Jsum, C[2, 2]))),
-    ) + planar.compliance_pieces() + (
-        Block(((Gn, Gn_), (Gt, Gt_), (Cnn, C[0, 0]), (Cnt, C[0, 1]), (Ctt, C[1, 1]),
-               # Moment restitution solved for M: e_m in the denominator.
-               (M, (1 - e_m) * Wr / (e_m * Jsum))),
-              _separating_guard()),
-        Block(((Dn, Cnn + mu * Cnt), (dgn_inv, (1 + e) * Gn / e)),
-              Guard((sp.Ne(Dn, 0),), "SINGULAR")),
-        Block(((Pn, -(dgn_inv + Cnm * M) / Dn),)),
-        Block(((Pt, mu * Pn),)),
-        Block(((Px, px), (Py, py), (c1, r1n * Pt - r1t * Pn), (c2, r2n * Pt - r2t * Pn),
-               (gn, gn_), (gt, Gt + Cnt * Pn + Ctt * Pt + Ctm * M),
-               (wr, Wr + Cnm * Pn + Ctm * Pt + Jsum * M))),
-        Block(((v1x, V1x - k1 * Px), (v1y, V1y - k1 * Py), (v2x, V2x + k2 * Px),
-               (v2y, V2y + k2 * Py), (w1, W1 - j1 * (c1 + M)), (w2, W2 + j2 * (c2 + M)),
-               # (gn + Gn) = Gn (e - 1)/e: one factor, as in the forward kernels.
-               (TLn, Pn * sp.factor(gn_ + Gn) / 2), (TLt, Pt * (gt + Gt) / 2),
-               (TLm, M * (wr + Wr) / 2))),
-        Block(((TL, TLn + TLt + TLm),)),
-        # μ_c of the recovered scene: the forward kernel's sticking ratio.
-    ) + planar.critical_ratio_blocks()
+        (
+            Block(
+                f.inverse_masses((m1, m2, I1, I2), (k1, k2, j1, j2))
+                + f.normal_components()
+                + ((dVx, V2x - V1x), (dVy, V2y - V1y), (Wr, W2 - W1), (drx, r1x - r2x), (dry, r1y - r2y)),
+                Guard((sp.StrictGreaterThan(k1 + k2, 0), sp.StrictGreaterThan(j1 + j2, 0)), "SINGULAR"),
+            ),
+            Block(
+                (
+                    (r1n, r1n_),
+                    (r1t, r1t_),
+                    (r2n, r2n_),
+                    (r2t, r2t_),
+                    (Gx, final_rel[0]),
+                    (Gy, final_rel[1]),
+                    (Jsum, C[2, 2]),
+                )
+            ),
+        )
+        + planar.compliance_pieces()
+        + (
+            Block(
+                (
+                    (Gn, Gn_),
+                    (Gt, Gt_),
+                    (Cnn, C[0, 0]),
+                    (Cnt, C[0, 1]),
+                    (Ctt, C[1, 1]),
+                    # Moment restitution solved for M: e_m in the denominator.
+                    (M, (1 - e_m) * Wr / (e_m * Jsum)),
+                ),
+                _separating_guard(),
+            ),
+            Block(((Dn, Cnn + mu * Cnt), (dgn_inv, (1 + e) * Gn / e)), Guard((sp.Ne(Dn, 0),), "SINGULAR")),
+            Block(((Pn, -(dgn_inv + Cnm * M) / Dn),)),
+            Block(((Pt, mu * Pn),)),
+            Block(
+                (
+                    (Px, px),
+                    (Py, py),
+                    (c1, r1n * Pt - r1t * Pn),
+                    (c2, r2n * Pt - r2t * Pn),
+                    (gn, gn_),
+                    (gt, Gt + Cnt * Pn + Ctt * Pt + Ctm * M),
+                    (wr, Wr + Cnm * Pn + Ctm * Pt + Jsum * M),
+                )
+            ),
+            Block(
+                (
+                    (v1x, V1x - k1 * Px),
+                    (v1y, V1y - k1 * Py),
+                    (v2x, V2x + k2 * Px),
+                    (v2y, V2y + k2 * Py),
+                    (w1, W1 - j1 * (c1 + M)),
+                    (w2, W2 + j2 * (c2 + M)),
+                    # (gn + Gn) = Gn (e - 1)/e: one factor, as in the forward kernels.
+                    (TLn, Pn * sp.factor(gn_ + Gn) / 2),
+                    (TLt, Pt * (gt + Gt) / 2),
+                    (TLm, M * (wr + Wr) / 2),
+                )
+            ),
+            Block(((TL, TLn + TLt + TLm),)),
+            # μ_c of the recovered scene: the forward kernel's sticking ratio.
+        )
+        + planar.critical_ratio_blocks()
+    )
 
 
 def _particle_blocks():
     gn_ = -Gn / e
     px, py = f.to_scene_frame(Pn, Pt)
     return (
-        Block(f.inverse_masses((m1, m2), (k1, k2)) + f.normal_components()
-              + ((dVx, V2x - V1x), (dVy, V2y - V1y)),
-              Guard((sp.StrictGreaterThan(k1 + k2, 0),), "SINGULAR")),
-        Block(((Gn, dVx * nx + dVy * ny), (Gt, dVy * nx - dVx * ny), (kk, k1 + k2)),
-              _separating_guard()),
+        Block(
+            f.inverse_masses((m1, m2), (k1, k2))
+            + f.normal_components()
+            + ((dVx, V2x - V1x), (dVy, V2y - V1y)),
+            Guard((sp.StrictGreaterThan(k1 + k2, 0),), "SINGULAR"),
+        ),
+        Block(((Gn, dVx * nx + dVy * ny), (Gt, dVy * nx - dVx * ny), (kk, k1 + k2)), _separating_guard()),
         Block(((Pn, -(1 + e) * Gn / (e * kk)),)),
         Block(((Pt, mu * Pn),)),
         # gn = -Gn/e < 0, unless it underflows (e huge): mu_c divides by it.
-        Block(((Px, px), (Py, py), (gn, gn_), (gt, Gt + kk * Pt)),
-              Guard((sp.StrictLessThan(gn, 0),), "NOT_APPROACHING")),
-        Block(((v1x, V1x - k1 * Px), (v1y, V1y - k1 * Py), (v2x, V2x + k2 * Px),
-               (v2y, V2y + k2 * Py), (TLn, Pn * sp.factor(gn_ + Gn) / 2),
-               (TLt, Pt * (gt + Gt) / 2), (mu_c, gt / ((1 + e) * gn)))),
+        Block(
+            ((Px, px), (Py, py), (gn, gn_), (gt, Gt + kk * Pt)),
+            Guard((sp.StrictLessThan(gn, 0),), "NOT_APPROACHING"),
+        ),
+        Block(
+            (
+                (v1x, V1x - k1 * Px),
+                (v1y, V1y - k1 * Py),
+                (v2x, V2x + k2 * Px),
+                (v2y, V2y + k2 * Py),
+                (TLn, Pn * sp.factor(gn_ + Gn) / 2),
+                (TLt, Pt * (gt + Gt) / 2),
+                (mu_c, gt / ((1 + e) * gn)),
+            )
+        ),
         Block(((TL, TLn + TLt),)),
     )
 
@@ -163,19 +213,24 @@ def _kernel(rigid: bool) -> Kernel:
         masses = (m1, m2, I1, I2)
         energy, work = (TL, TLn, TLt, TLm), ((Pn, gn), (Pt, gt), (M, wr))
     else:
-        name, inputs, outputs, blocks = ("particle_inverse", PARTICLE_INPUTS,
-                                         PARTICLE_OUTPUTS, _particle_blocks())
+        name, inputs, outputs, blocks = (
+            "particle_inverse",
+            PARTICLE_INPUTS,
+            PARTICLE_OUTPUTS,
+            _particle_blocks(),
+        )
         scalars = (V1x, V1y, V2x, V2y, gamma, e, mu)
         masses = (m1, m2)
         energy, work = (TL, TLn, TLt), ((Pn, gn), (Pt, gt))
     tolerances, flags = f.physics_flags(energy, work, mu_used=mu)
     return Kernel(
         name=name,
-        doc=("Pre-impact velocities from post-impact ones, "
-             + ("rigid bodies (Brach)." if rigid else "particles.")),
+        doc=(
+            "Pre-impact velocities from post-impact ones, "
+            + ("rigid bodies (Brach)." if rigid else "particles.")
+        ),
         inputs=inputs,
-        checks=(finite_inputs(scalars, masses), positive_or_fixed(masses))
-        + _coefficient_guards(rigid),
+        checks=(finite_inputs(scalars, masses), positive_or_fixed(masses)) + _coefficient_guards(rigid),
         blocks=blocks + (tolerances,),
         outputs=outputs,
         flags=flags,
@@ -186,6 +241,7 @@ KERNELS = (_kernel(rigid=True), _kernel(rigid=False))
 
 
 # ---------------------------------------------------------------- proofs
+
 
 def _zero(expr) -> bool:
     return f.reduce_unit_normal(expr) == 0
@@ -200,20 +256,31 @@ def proofs():
     got = {s: rigid.expanded(s, keep) for s in RIGID_OUTPUTS + (Px, Py)}
     got.update({s: s for s in (V1x, V1y, W1, V2x, V2y, W2)})
     res, rel = planar.six_equation_residuals(got, sticking=False)
-    out.append(("rigid_inverse: recovered initials and given finals satisfy the six equations",
-                all(_zero(r) for r in res)))
+    out.append(
+        (
+            "rigid_inverse: recovered initials and given finals satisfy the six equations",
+            all(_zero(r) for r in res),
+        )
+    )
     # The kernel's gn, gt, wr are the initial relative motion of the recovered
     # initials (expanded); given that and restitution (proven above), the
     # energy parts are the work of the impulse components (identities in atoms).
-    u = [(got[v1x] - got[w1] * r1y, got[v1y] + got[w1] * r1x),
-         (got[v2x] - got[w2] * r2y, got[v2y] + got[w2] * r2x)]
+    u = [
+        (got[v1x] - got[w1] * r1y, got[v1y] + got[w1] * r1x),
+        (got[v2x] - got[w2] * r2y, got[v2y] + got[w2] * r2x),
+    ]
     gn0, gt0 = f.to_impact_frame(u[1][0] - u[0][0], u[1][1] - u[0][1])
-    kinematic = (_zero(rigid.expanded(gn, keep) - gn0) and _zero(rigid.expanded(gt, keep) - gt0)
-                 and _zero(rigid.expanded(wr, keep) - (got[w2] - got[w1])))
+    kinematic = (
+        _zero(rigid.expanded(gn, keep) - gn0)
+        and _zero(rigid.expanded(gt, keep) - gt0)
+        and _zero(rigid.expanded(wr, keep) - (got[w2] - got[w1]))
+    )
     atoms = frozenset({Pn, Pt, M, gn, gt, wr, Gn, Gt, Wr})
-    parts = (sp.simplify(rigid.expanded(TLn, atoms) - Pn * (gn + Gn) / 2 + Pn * (gn + Gn / e) / 2) == 0
-             and sp.expand(rigid.expanded(TLt, atoms) - Pt * (gt + Gt) / 2) == 0
-             and sp.expand(rigid.expanded(TLm, atoms) - M * (wr + Wr) / 2) == 0)
+    parts = (
+        sp.simplify(rigid.expanded(TLn, atoms) - Pn * (gn + Gn) / 2 + Pn * (gn + Gn / e) / 2) == 0
+        and sp.expand(rigid.expanded(TLt, atoms) - Pt * (gt + Gt) / 2) == 0
+        and sp.expand(rigid.expanded(TLm, atoms) - M * (wr + Wr) / 2) == 0
+    )
     out.append(("rigid_inverse: TLn, TLt, TLm are the work of Pn, Pt, M", kinematic and parts))
     pkeep = frozenset({k1, k2, nx, ny})
     pgot = {s: particle.expanded(s, pkeep) for s in PARTICLE_OUTPUTS + (Px, Py)}
@@ -221,6 +288,10 @@ def proofs():
     pgot.update({s: s for s in (V1x, V1y, V2x, V2y)})
     zero_arms = {r1x: 0, r1y: 0, r2x: 0, r2y: 0}
     pres, _ = planar.six_equation_residuals(pgot, sticking=False)
-    out.append(("particle_inverse: recovered initials and given finals satisfy eqs 1-7",
-                all(_zero(r.xreplace(zero_arms)) for i, r in enumerate(pres) if i not in (4, 5, 7))))
+    out.append(
+        (
+            "particle_inverse: recovered initials and given finals satisfy eqs 1-7",
+            all(_zero(r.xreplace(zero_arms)) for i, r in enumerate(pres) if i not in (4, 5, 7)),
+        )
+    )
     return out

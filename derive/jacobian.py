@@ -76,10 +76,14 @@ def jacobian_kernel(base: Kernel, name: str | None = None) -> Kernel:
                 zeros.append((derivative_name(base.public_name(out), x.name), 0.0))
             else:
                 outputs.append(dsym)
-    return replace(base, name=name or f"{base.name}_jacobian",
-                   doc=f"{base.doc} With exact first derivatives d_<output>__d_<input>.",
-                   blocks=tuple(blocks), outputs=tuple(base.outputs) + tuple(outputs),
-                   constants=tuple(base.constants) + tuple(zeros))
+    return replace(
+        base,
+        name=name or f"{base.name}_jacobian",
+        doc=f"{base.doc} With exact first derivatives d_<output>__d_<input>.",
+        blocks=tuple(blocks),
+        outputs=tuple(base.outputs) + tuple(outputs),
+        constants=tuple(base.constants) + tuple(zeros),
+    )
 
 
 def _needed_by_outputs(base: Kernel) -> set:
@@ -111,10 +115,18 @@ def _chain_rule(expr: sp.Expr, tangents: dict) -> dict:
 
 # The kernels with derivatives: forward (given and critical μ), inverse,
 # reconstruction, CRASH3 energy and delta-V. Base (angle) form, every input.
-BASES = (planar.KERNELS + particle.KERNELS + inverse.KERNELS + reconstruct.KERNELS
-         + tuple(k for k in crash3.KERNELS if k.name.startswith("crash3_energy"))
-         + tuple(k for k in crash3.KERNELS
-                 if k.name in ("crash3_delta_v", "crash3_moment_arm", "crash3_radius_of_gyration")))
+BASES = (
+    planar.KERNELS
+    + particle.KERNELS
+    + inverse.KERNELS
+    + reconstruct.KERNELS
+    + tuple(k for k in crash3.KERNELS if k.name.startswith("crash3_energy"))
+    + tuple(
+        k
+        for k in crash3.KERNELS
+        if k.name in ("crash3_delta_v", "crash3_moment_arm", "crash3_radius_of_gyration")
+    )
+)
 
 KERNELS = tuple(jacobian_kernel(k) for k in BASES)
 
@@ -125,13 +137,27 @@ KERNELS = tuple(jacobian_kernel(k) for k in BASES)
 # a number in [-3, 3]). Chosen so the guards pass for most draws; a draw that
 # fails a guard is redrawn.
 RANGES = {
-    "m1": (1, 3), "m2": (1, 3), "I1": (1, 3), "I2": (1, 3), "mass": (1, 3), "inertia": (1, 3),
-    "e": (sp.Rational(1, 10), sp.Rational(9, 10)), "e_m": (sp.Rational(1, 10), sp.Rational(9, 10)),
-    "mu": (sp.Rational(-1, 2), sp.Rational(1, 2)), "gamma": (-1, 1),
+    "m1": (1, 3),
+    "m2": (1, 3),
+    "I1": (1, 3),
+    "I2": (1, 3),
+    "mass": (1, 3),
+    "inertia": (1, 3),
+    "e": (sp.Rational(1, 10), sp.Rational(9, 10)),
+    "e_m": (sp.Rational(1, 10), sp.Rational(9, 10)),
+    "mu": (sp.Rational(-1, 2), sp.Rational(1, 2)),
+    "gamma": (-1, 1),
     "alpha": (sp.Rational(-7, 10), sp.Rational(7, 10)),
-    "alpha1": (-1, 1), "alpha2": (-1, 1), "A": (1, 3), "B": (1, 3), "width": (1, 3),
-    "rg1": (1, 3), "rg2": (1, 3), "E": (1, 3),
-    "theta1": (0, 1), "theta2": (2, 3),
+    "alpha1": (-1, 1),
+    "alpha2": (-1, 1),
+    "A": (1, 3),
+    "B": (1, 3),
+    "width": (1, 3),
+    "rg1": (1, 3),
+    "rg2": (1, 3),
+    "E": (1, 3),
+    "theta1": (0, 1),
+    "theta2": (2, 3),
 }
 
 
@@ -142,7 +168,8 @@ def _random_point(knl: Kernel, rng: random.Random) -> dict:
         if x.name.startswith("C") and x.name[1:].isdigit():
             lo, hi = 0, 1
         point[x] = sp.Rational(lo) + (sp.Rational(hi) - sp.Rational(lo)) * sp.Rational(
-            rng.randint(1, 999), 1000)
+            rng.randint(1, 999), 1000
+        )
     return point
 
 
@@ -153,8 +180,7 @@ def _evaluate(knl: Kernel, point: dict) -> dict | None:
     for block in knl.blocks:
         for sym, expr in block.assigns:
             values[sym] = sp.N(expr.xreplace(values), DIGITS)
-        if block.guard is not None and not all(
-                bool(c.xreplace(values)) for c in block.guard.conditions):
+        if block.guard is not None and not all(bool(c.xreplace(values)) for c in block.guard.conditions):
             return None
     return values
 
@@ -202,7 +228,13 @@ def proofs():
     """(claim, passed): every Jacobian kernel's derivative outputs equal
     SymPy's derivatives of its value kernel's outputs at random points."""
     rng = random.Random(20261123)
-    return [((f"{knl.name}: every d_output__d_input equals sympy.diff of the expanded "
-              f"{base.name} output at 2 random rational points ({DIGITS} digits)"),
-             _agrees(knl, base, rng, points=2))
-            for knl, base in zip(KERNELS, BASES)]
+    return [
+        (
+            (
+                f"{knl.name}: every d_output__d_input equals sympy.diff of the expanded "
+                f"{base.name} output at 2 random rational points ({DIGITS} digits)"
+            ),
+            _agrees(knl, base, rng, points=2),
+        )
+        for knl, base in zip(KERNELS, BASES)
+    ]

@@ -114,8 +114,7 @@ class NotNaN(sp.Function):
 def finite_inputs(symbols, masses=()) -> Guard:
     """Guard: every one of `symbols` is a finite number and no mass or inertia is
     NaN (a mass may be +inf: a fixed body)."""
-    return Guard(tuple(IsFinite(s) for s in symbols) + tuple(NotNaN(m) for m in masses),
-                 "NONFINITE_INPUT")
+    return Guard(tuple(IsFinite(s) for s in symbols) + tuple(NotNaN(m) for m in masses), "NONFINITE_INPUT")
 
 
 def positive_or_fixed(symbols) -> Guard:

@@ -122,12 +122,18 @@ def _kernel_blocks(sticking: bool):
             Guard((sp.StrictGreaterThan(k1 + k2, 0),), "SINGULAR"),
             equation="conventions.md frame: k = 1/m, n = (cos gamma, sin gamma)",
         ),
-        Block(((gn, gn_), (gt, gt_), (mbar, 1 / (k1 + k2))), f.approach_guard(),
-              equation="approach in the impact frame (seed Fig. 1); reduced mass (seed eq 17)"),
+        Block(
+            ((gn, gn_), (gt, gt_), (mbar, 1 / (k1 + k2))),
+            f.approach_guard(),
+            equation="approach in the impact frame (seed Fig. 1); reduced mass (seed eq 17)",
+        ),
         # e = -1 (or an underflowing product) gives no normal impulse: mu_c divides by dgn.
-        Block(((dgn, -(1 + e) * gn), (dgt, dgt_)), Guard((sp.Ne(dgn, 0),), "SINGULAR"),
-              equation="restitution (seed eq 3); " + ("end of sliding (seed eq 8)" if sticking
-                                                      else "impulse ratio (seed eq 5)")),
+        Block(
+            ((dgn, -(1 + e) * gn), (dgt, dgt_)),
+            Guard((sp.Ne(dgn, 0),), "SINGULAR"),
+            equation="restitution (seed eq 3); "
+            + ("end of sliding (seed eq 8)" if sticking else "impulse ratio (seed eq 5)"),
+        ),
         Block(
             (
                 # Δ(v2 - v1) = -(1/m1 + 1/m2)·P, so P = -m̄·Δg (eqs 4, 6).
@@ -167,10 +173,10 @@ def _kernel_blocks(sticking: bool):
 def kernel(sticking: bool) -> Kernel:
     """The particle kernel, sliding (given μ) or sticking (μ = μ_max)."""
     name = "particle_critical" if sticking else "particle"
-    doc = (
-        "Two-particle impact, "
-        + ("sliding ends before separation (mu = mu_c, seed eqs 10, 12, 14, 15)."
-           if sticking else "impulse ratio mu given (seed eqs 10-13).")
+    doc = "Two-particle impact, " + (
+        "sliding ends before separation (mu = mu_c, seed eqs 10, 12, 14, 15)."
+        if sticking
+        else "impulse ratio mu given (seed eqs 10-13)."
     )
     tolerances, flags = f.physics_flags((TL, TLn, TLt), ((Pn, gn), (Pt, gt)))
     return Kernel(
@@ -195,6 +201,7 @@ EMITTED = tuple(k for base in KERNELS for k in specialise.tiers(specialise.norma
 
 # ---------------------------------------------------------------- proofs
 
+
 def _seed_frame_values():
     """The seed's impact-frame symbols in terms of the kernel's inputs."""
     n1, t1 = f.to_impact_frame(v1x, v1y)
@@ -215,41 +222,69 @@ def proofs():
         tag = knl.name
         solved = sp.solve(seed_equations(sticking), [V1n, V1t, V2n, V2t], dict=True)[0]
         printed = seed_printed_solution(sticking)
-        out.append((f"{tag}: SymPy's solution of eqs 1-3,{'8' if sticking else '7'} "
-                    "equals the printed eqs",
-                    all(sp.simplify(solved[s] - printed[s]) == 0 for s in printed)))
-        got = {s: knl.expanded(s, keep) for s in (V1x, V1y, V2x, V2y, Pn, Pt, TL, TLn, TLt,
-                                                  mu_c, mu_used)}
+        out.append(
+            (
+                f"{tag}: SymPy's solution of eqs 1-3,{'8' if sticking else '7'} equals the printed eqs",
+                all(sp.simplify(solved[s] - printed[s]) == 0 for s in printed),
+            )
+        )
+        got = {s: knl.expanded(s, keep) for s in (V1x, V1y, V2x, V2y, Pn, Pt, TL, TLn, TLt, mu_c, mu_used)}
         finals = {}
         for (sx, sy), (sn, st) in (((V1x, V1y), (V1n, V1t)), ((V2x, V2y), (V2n, V2t))):
             finals[sn], finals[st] = f.to_impact_frame(got[sx], got[sy])
-        out.append((f"{tag}: kernel final velocities equal the printed solution",
-                    all(_zero(finals[s] - printed[s].xreplace(seed_vals)) for s in printed)))
-        out.append((f"{tag}: dV1, dV2 are |V1 - v1|, |V2 - v2|",
-                    f.delta_v_magnitudes_hold(lambda x, knl=knl: knl.expanded(x, keep | {Pn, Pt}))))
-        out.append((f"{tag}: P equals m1 (V1 - v1) (eqs 4, 6)",
-                    _zero(got[Pn] - (finals[V1n] - seed_vals[v1n]) / k1)
-                    and _zero(got[Pt] - (finals[V1t] - seed_vals[v1t]) / k1)))
+        out.append(
+            (
+                f"{tag}: kernel final velocities equal the printed solution",
+                all(_zero(finals[s] - printed[s].xreplace(seed_vals)) for s in printed),
+            )
+        )
+        out.append(
+            (
+                f"{tag}: dV1, dV2 are |V1 - v1|, |V2 - v2|",
+                f.delta_v_magnitudes_hold(lambda x, knl=knl: knl.expanded(x, keep | {Pn, Pt})),
+            )
+        )
+        out.append(
+            (
+                f"{tag}: P equals m1 (V1 - v1) (eqs 4, 6)",
+                _zero(got[Pn] - (finals[V1n] - seed_vals[v1n]) / k1)
+                and _zero(got[Pt] - (finals[V1t] - seed_vals[v1t]) / k1),
+            )
+        )
         ke_before = (v1x**2 + v1y**2) / (2 * k1) + (v2x**2 + v2y**2) / (2 * k2)
         ke_after = (got[V1x] ** 2 + got[V1y] ** 2) / (2 * k1) + (got[V2x] ** 2 + got[V2y] ** 2) / (2 * k2)
-        out.append((f"{tag}: TL equals the kinetic-energy difference (eq 16)",
-                    _zero(ke_before - ke_after - got[TL])))
+        out.append(
+            (f"{tag}: TL equals the kinetic-energy difference (eq 16)", _zero(ke_before - ke_after - got[TL]))
+        )
         gn_i = seed_vals[v2n] - seed_vals[v1n]
         gt_i = seed_vals[v2t] - seed_vals[v1t]
-        out.append((f"{tag}: TLn = Pn (gn + Gn)/2 and TLt = Pt (gt + Gt)/2 (eqs 21-26)",
-                    _zero(got[TLn] - got[Pn] * (gn_i + finals[V2n] - finals[V1n]) / 2)
-                    and _zero(got[TLt] - got[Pt] * (gt_i + finals[V2t] - finals[V1t]) / 2)))
+        out.append(
+            (
+                f"{tag}: TLn = Pn (gn + Gn)/2 and TLt = Pt (gt + Gt)/2 (eqs 21-26)",
+                _zero(got[TLn] - got[Pn] * (gn_i + finals[V2n] - finals[V1n]) / 2)
+                and _zero(got[TLt] - got[Pt] * (gt_i + finals[V2t] - finals[V1t]) / 2),
+            )
+        )
         tl17, mu_max = seed_energy_loss()
         mu_here = mu_max if sticking else mu
-        out.append((f"{tag}: TL equals eq 17, mu_c equals eq 18",
-                    _zero(got[TL] - tl17.xreplace({mu: mu_here}).xreplace(seed_vals))
-                    and _zero(got[mu_c] - mu_max.xreplace(seed_vals))))
+        out.append(
+            (
+                f"{tag}: TL equals eq 17, mu_c equals eq 18",
+                _zero(got[TL] - tl17.xreplace({mu: mu_here}).xreplace(seed_vals))
+                and _zero(got[mu_c] - mu_max.xreplace(seed_vals)),
+            )
+        )
         if sticking:
-            out.append((f"{tag}: final tangential velocities are equal (eq 8)",
-                        _zero(finals[V1t] - finals[V2t])))
+            out.append(
+                (f"{tag}: final tangential velocities are equal (eq 8)", _zero(finals[V1t] - finals[V2t]))
+            )
         else:
             at_crit = {mu: got[mu_c]}
-            out.append((f"{tag}: mu = mu_c ends sliding (Gt = 0) and maximises TL",
-                        _zero((finals[V2t] - finals[V1t]).xreplace(at_crit))
-                        and _zero(sp.diff(got[TL], mu).xreplace(at_crit))))
+            out.append(
+                (
+                    f"{tag}: mu = mu_c ends sliding (Gt = 0) and maximises TL",
+                    _zero((finals[V2t] - finals[V1t]).xreplace(at_crit))
+                    and _zero(sp.diff(got[TL], mu).xreplace(at_crit)),
+                )
+            )
     return out

@@ -134,23 +134,47 @@ def _frame_blocks():
         Block(
             f.inverse_masses((m1, m2, I1, I2), (k1, k2, j1, j2))
             + f.normal_components()
-            + ((dvx, v2x - v1x), (dvy, v2y - v1y), (wr, w2 - w1),
-               (drx, r1x - r2x), (dry, r1y - r2y), (r12, r1x * r2y - r1y * r2x)),
-            Guard((sp.StrictGreaterThan(k1 + k2, 0), sp.StrictGreaterThan(j1 + j2, 0)),
-                  "SINGULAR"),
+            + (
+                (dvx, v2x - v1x),
+                (dvy, v2y - v1y),
+                (wr, w2 - w1),
+                (drx, r1x - r2x),
+                (dry, r1y - r2y),
+                (r12, r1x * r2y - r1y * r2x),
+            ),
+            Guard((sp.StrictGreaterThan(k1 + k2, 0), sp.StrictGreaterThan(j1 + j2, 0)), "SINGULAR"),
             equation="conventions.md frame: k = 1/m, j = 1/I, n = (cos gamma, sin gamma)",
         ),
-        Block(((r1n, r1n_), (r1t, r1t_), (r2n, r2n_), (r2t, r2t_), (gx, gx_), (gy, gy_),
-               (drn, drn_), (drt, drt_), (kk, k1 + k2), (jbar, j1 * j2 / (j1 + j2))),
-              equation="arms in the impact frame; u2 - u1 at the impact centre, u_i = v_i + w_i z x r_i"),
         Block(
-            ((gn, gn_), (gt, gt_), (Cnm, C[0, 2]), (Ctm, C[1, 2]),
-             # 1 - e_m kept as one factor: e_m = 1 gives exactly no moment impulse.
-             (am, (1 - e_m) / C[2, 2]),
-             (wa, e_m * j1), (wb, e_m * j2), (wc, (1 - e_m) * jbar)),
+            (
+                (r1n, r1n_),
+                (r1t, r1t_),
+                (r2n, r2n_),
+                (r2t, r2t_),
+                (gx, gx_),
+                (gy, gy_),
+                (drn, drn_),
+                (drt, drt_),
+                (kk, k1 + k2),
+                (jbar, j1 * j2 / (j1 + j2)),
+            ),
+            equation="arms in the impact frame; u2 - u1 at the impact centre, u_i = v_i + w_i z x r_i",
+        ),
+        Block(
+            (
+                (gn, gn_),
+                (gt, gt_),
+                (Cnm, C[0, 2]),
+                (Ctm, C[1, 2]),
+                # 1 - e_m kept as one factor: e_m = 1 gives exactly no moment impulse.
+                (am, (1 - e_m) / C[2, 2]),
+                (wa, e_m * j1),
+                (wb, e_m * j2),
+                (wc, (1 - e_m) * jbar),
+            ),
             f.approach_guard(),
             equation="compliance C from impulse-momentum (six equations 1, 2); "
-                     "moment restitution (six equations 5)",
+            "moment restitution (six equations 5)",
         ),
     )
 
@@ -190,8 +214,16 @@ def compliance_pieces():
     C = compliance()
     return (
         Block(((drn, drn_), (drt, drt_), (kk, k1 + k2), (jbar, j1 * j2 / (j1 + j2)))),
-        Block(((am, (1 - e_m) / C[2, 2]), (wa, e_m * j1), (wb, e_m * j2),
-               (wc, (1 - e_m) * jbar), (Cnm, C[0, 2]), (Ctm, C[1, 2]))),
+        Block(
+            (
+                (am, (1 - e_m) / C[2, 2]),
+                (wa, e_m * j1),
+                (wb, e_m * j2),
+                (wc, (1 - e_m) * jbar),
+                (Cnm, C[0, 2]),
+                (Ctm, C[1, 2]),
+            )
+        ),
     )
 
 
@@ -218,17 +250,25 @@ def _impulse_blocks(sticking: bool):
     else:
         denom, pn, pt = (D, Knn + mu * Knt), bn / D, mu * bn / D
     return (
-        Block(tuple(keff.items()) + ((dgn, -(1 + e) * gn),),
-              equation="effective compliance K (M eliminated); restitution (seed eq 3, "
-                       "six equations 3)"),
+        Block(
+            tuple(keff.items()) + ((dgn, -(1 + e) * gn),),
+            equation="effective compliance K (M eliminated); restitution (seed eq 3, six equations 3)",
+        ),
         Block(((bn, -(dgn + hn)), (bt, gt - ht)), equation="K (Pn, Pt) = (bn, bt)"),
-        Block((denom, (Dc, pn_c)),
-              Guard((sp.Ne(D, 0), sp.Ne(Dc, 0)), "SINGULAR"),
-              equation=("no sliding at separation (seed eq 8)" if sticking else
-                        "impulse ratio Pt = mu Pn (seed eq 5, six equations 4)")),
+        Block(
+            (denom, (Dc, pn_c)),
+            Guard((sp.Ne(D, 0), sp.Ne(Dc, 0)), "SINGULAR"),
+            equation=(
+                "no sliding at separation (seed eq 8)"
+                if sticking
+                else "impulse ratio Pt = mu Pn (seed eq 5, six equations 4)"
+            ),
+        ),
         # μ_c: the ratio Pt/Pn of the sticking solution (det K cancels).
-        Block(((mu_c, pt_c / Dc), (Pn, pn), (Pt, pt)),
-              equation="impulses; mu_c, the seed's mu_max (eq 18) generalised"),
+        Block(
+            ((mu_c, pt_c / Dc), (Pn, pn), (Pt, pt)),
+            equation="impulses; mu_c, the seed's mu_max (eq 18) generalised",
+        ),
     )
 
 
@@ -258,21 +298,30 @@ def yaw_changes():
     formed directly, survives large inertial weights."""
     jsum = compliance()[2, 2]
     common = 1 - e_m
-    return (e_m * j1 * c1 + common * (jbar * cd + wr * j1 / jsum),
-            -e_m * j2 * c2 + common * (jbar * cd - wr * j2 / jsum))
+    return (
+        e_m * j1 * c1 + common * (jbar * cd + wr * j1 / jsum),
+        -e_m * j2 * c2 + common * (jbar * cd - wr * j2 / jsum),
+    )
 
 
 def _final_blocks(sticking: bool):
     """Finals from the impulses, and energy loss as the work of each component."""
     px, py = f.to_scene_frame(Pn, Pt)
     gt_final = 0 if sticking else gt - (Knt * Pn + Ktt * Pt) - ht
-    levers = lever_products_sticking() if sticking else (
-        _cross(r1n, r1t, Pn, Pt), _cross(r2n, r2t, Pn, Pt), _cross(drn, drt, Pn, Pt))
+    levers = (
+        lever_products_sticking()
+        if sticking
+        else (_cross(r1n, r1t, Pn, Pt), _cross(r2n, r2t, Pn, Pt), _cross(drn, drt, Pn, Pt))
+    )
     dw1, dw2 = yaw_changes()
     return (
         Block(
             (
-                (Px, px), (Py, py), (c1, levers[0]), (c2, levers[1]), (cd, levers[2]),
+                (Px, px),
+                (Py, py),
+                (c1, levers[0]),
+                (c2, levers[1]),
+                (cd, levers[2]),
                 *f.delta_v_magnitudes(),
                 (mu_used, mu_c if sticking else mu),
                 # (gn + Gn) with Gn = -e·gn factors to (1 - e)·gn (see particle).
@@ -285,9 +334,12 @@ def _final_blocks(sticking: bool):
             (
                 # Relative yaw rate at separation if there were no moment impulse.
                 (s, wr - (j1 * c1 + j2 * c2)),
-                (V1x, v1x + k1 * Px), (V1y, v1y + k1 * Py),
-                (V2x, v2x - k2 * Px), (V2y, v2y - k2 * Py),
-                (W1, w1 + dw1), (W2, w2 + dw2),
+                (V1x, v1x + k1 * Px),
+                (V1y, v1y + k1 * Py),
+                (V2x, v2x - k2 * Px),
+                (V2y, v2y - k2 * Py),
+                (W1, w1 + dw1),
+                (W2, w2 + dw2),
             ),
             equation="final velocities from impulse-momentum (six equations 1, 2)",
         ),
@@ -306,8 +358,9 @@ def _final_blocks(sticking: bool):
 def kernel(sticking: bool) -> Kernel:
     """The rigid-body kernel, impulse ratio given (sliding) or μ = μ_c (sticking)."""
     name = "rigid_critical" if sticking else "rigid"
-    doc = ("General planar rigid-body impact (Brach), "
-           + ("no sliding at separation (mu = mu_c)." if sticking else "impulse ratio mu given."))
+    doc = "General planar rigid-body impact (Brach), " + (
+        "no sliding at separation (mu = mu_c)." if sticking else "impulse ratio mu given."
+    )
     scalars = (v1x, v1y, w1, v2x, v2y, w2, r1x, r1y, r2x, r2y, gamma, e, e_m)
     tolerances, flags = f.physics_flags((TL, TLn, TLt, TLm), ((Pn, gn), (Pt, gt), (M, wr)))
     return Kernel(
@@ -318,11 +371,9 @@ def kernel(sticking: bool) -> Kernel:
             finite_inputs(scalars + (() if sticking else (mu,)), (m1, m2, I1, I2)),
             positive_or_fixed((m1, m2, I1, I2)),
             # A fixed body has infinite mass AND inertia, or neither.
-            Guard((sp.Eq(IsFinite(m1), IsFinite(I1)), sp.Eq(IsFinite(m2), IsFinite(I2))),
-                  "BAD_MASS"),
+            Guard((sp.Eq(IsFinite(m1), IsFinite(I1)), sp.Eq(IsFinite(m2), IsFinite(I2))), "BAD_MASS"),
         ),
-        blocks=_frame_blocks() + _impulse_blocks(sticking) + _final_blocks(sticking)
-        + (tolerances,),
+        blocks=_frame_blocks() + _impulse_blocks(sticking) + _final_blocks(sticking) + (tolerances,),
         outputs=OUTPUTS,
         flags=flags,
     )
@@ -337,8 +388,9 @@ def emitted_kernels() -> tuple[Kernel, ...]:
     out = []
     for base in KERNELS:
         general = specialise.normal_form(base)
-        no_moment = specialise.fix_inputs(general, f"{base.name}_em1", {e_m: 1},
-                                          "Moment restitution e_m = 1: no moment impulse.")
+        no_moment = specialise.fix_inputs(
+            general, f"{base.name}_em1", {e_m: 1}, "Moment restitution e_m = 1: no moment impulse."
+        )
         out += specialise.tiers(general) + specialise.tiers(no_moment)
     return tuple(out)
 
@@ -355,13 +407,22 @@ def ke_difference_kernel() -> Kernel:
     def energy(vx, vy, w, m, inertia):
         return m * (vx**2 + vy**2) / 2 + inertia * w**2 / 2
 
-    naive = (energy(v1x, v1y, w1, m1, I1) + energy(v2x, v2y, w2, m2, I2)
-             - energy(V1x, V1y, W1, m1, I1) - energy(V2x, V2y, W2, m2, I2))
-    blocks = tuple(Block(((TL, naive),)) if block.assigns[0][0] == TL else block
-                   for block in base.blocks)
-    return Kernel(name="rigid_ke_difference", doc=base.doc + " TL as a kinetic-energy difference.",
-                  inputs=base.inputs, checks=base.checks, blocks=blocks,
-                  outputs=base.outputs, flags=base.flags)
+    naive = (
+        energy(v1x, v1y, w1, m1, I1)
+        + energy(v2x, v2y, w2, m2, I2)
+        - energy(V1x, V1y, W1, m1, I1)
+        - energy(V2x, V2y, W2, m2, I2)
+    )
+    blocks = tuple(Block(((TL, naive),)) if block.assigns[0][0] == TL else block for block in base.blocks)
+    return Kernel(
+        name="rigid_ke_difference",
+        doc=base.doc + " TL as a kinetic-energy difference.",
+        inputs=base.inputs,
+        checks=base.checks,
+        blocks=blocks,
+        outputs=base.outputs,
+        flags=base.flags,
+    )
 
 
 # ---------------------------------------------------------------- proofs
@@ -373,8 +434,11 @@ def _cross_products(knl: Kernel) -> dict:
     """c_i → r_i × P in terms of (Pn, Pt): the lever products as the sliding
     kernel computes them (for the sticking kernel: lemma `_cramer_levers`)."""
     rn = {x: knl.expanded(x, KEEP) for x in (r1n, r1t, r2n, r2t, drn, drt)}
-    return {c1: _cross(rn[r1n], rn[r1t], Pn, Pt), c2: _cross(rn[r2n], rn[r2t], Pn, Pt),
-            cd: _cross(rn[drn], rn[drt], Pn, Pt)}
+    return {
+        c1: _cross(rn[r1n], rn[r1t], Pn, Pt),
+        c2: _cross(rn[r2n], rn[r2t], Pn, Pt),
+        cd: _cross(rn[drn], rn[drt], Pn, Pt),
+    }
 
 
 def _expanded(knl: Kernel, sym, atoms=frozenset()):
@@ -404,8 +468,10 @@ def six_equation_residuals(got, sticking: bool):
 
     rel = (U2[0] - U1[0], U2[1] - U1[1])
     res = [
-        got[V1x] - v1x_ - k1 * px, got[V1y] - v1y_ - k1 * py,
-        got[V2x] - v2x_ + k2 * px, got[V2y] - v2y_ + k2 * py,
+        got[V1x] - v1x_ - k1 * px,
+        got[V1y] - v1y_ - k1 * py,
+        got[V2x] - v2x_ + k2 * px,
+        got[V2y] - v2y_ + k2 * py,
         got[W1] - w1_ - j1 * (r1x * py - r1y * px + got[M]),
         got[W2] - w2_ + j2 * (r2x * py - r2y * px + got[M]),
         dot(n, rel) + e * dot(n, (u2[0] - u1[0], u2[1] - u1[1])),
@@ -436,9 +502,11 @@ def _six_equations_hold(knl: Kernel, sticking: bool) -> bool:
     res, rel = six_equation_residuals(free, sticking)
     Gn, Gt = f.to_impact_frame(*rel)
     keff = {sym: knl.expanded(sym, KEEP) for sym in (Knn, Knt, Ktt, hn, ht, gn, gt)}
-    step1 = all(_zero(r) for r in res[:6] + res[7:8]) and _zero(
-        Gn - (keff[gn] - keff[Knn] * Pn - keff[Knt] * Pt - keff[hn])) and _zero(
-        Gt - (keff[gt] - keff[Knt] * Pn - keff[Ktt] * Pt - keff[ht]))
+    step1 = (
+        all(_zero(r) for r in res[:6] + res[7:8])
+        and _zero(Gn - (keff[gn] - keff[Knn] * Pn - keff[Knt] * Pt - keff[hn]))
+        and _zero(Gt - (keff[gt] - keff[Knt] * Pn - keff[Ktt] * Pt - keff[ht]))
+    )
     small, lemma = _small_atoms(sticking)
     pn, pt = (knl.expanded(x, small).xreplace(lemma) for x in (Pn, Pt))
     restitution = (gn - Knn * pn - Knt * pt - hn) + e * gn
@@ -456,16 +524,32 @@ def _derivation_checks():
     m_sol = moment_impulse()
     C_syms = {Cnn: C[0, 0], Cnt: C[0, 1], Ctt: C[1, 1], Cnm: C[0, 2], Ctm: C[1, 2], Cmm: C[2, 2]}
     dg = -sp.Matrix([[Cnn, Cnt, Cnm], [Cnt, Ctt, Ctm]]) * sp.Matrix([Pn, Pt, m_sol])
-    pieces = {am: (1 - e_m) / Cmm, wa: e_m * j1, wb: e_m * j2, kk: k1 + k2,
-              wc: (1 - e_m) * j1 * j2 / (j1 + j2), drn: r1n - r2n, drt: r1t - r2t}
+    pieces = {
+        am: (1 - e_m) / Cmm,
+        wa: e_m * j1,
+        wb: e_m * j2,
+        kk: k1 + k2,
+        wc: (1 - e_m) * j1 * j2 / (j1 + j2),
+        drn: r1n - r2n,
+        drt: r1t - r2t,
+    }
     keff = {k: v.xreplace(pieces) for k, v in effective_compliance().items()}
-    structured = -sp.Matrix([[keff[Knn], keff[Knt]], [keff[Knt], keff[Ktt]]]) * sp.Matrix([Pn, Pt]) \
-        - sp.Matrix([keff[hn], keff[ht]])
-    out.append(("rigid: eliminating M (moment restitution) gives the effective K and h",
-                all(_zero((dg[i] - structured[i]).xreplace(C_syms)) for i in range(2))))
+    structured = -sp.Matrix([[keff[Knn], keff[Knt]], [keff[Knt], keff[Ktt]]]) * sp.Matrix(
+        [Pn, Pt]
+    ) - sp.Matrix([keff[hn], keff[ht]])
+    out.append(
+        (
+            "rigid: eliminating M (moment restitution) gives the effective K and h",
+            all(_zero((dg[i] - structured[i]).xreplace(C_syms)) for i in range(2)),
+        )
+    )
     stick = KERNELS[1]
-    out.append(("rigid: the Cauchy-Binet form of det K equals Knn Ktt - Knt^2",
-                _zero(stick.expanded(D, KEEP) - stick.expanded(Knn * Ktt - Knt**2, KEEP))))
+    out.append(
+        (
+            "rigid: the Cauchy-Binet form of det K equals Knn Ktt - Knt^2",
+            _zero(stick.expanded(D, KEEP) - stick.expanded(Knn * Ktt - Knt**2, KEEP)),
+        )
+    )
     return out
 
 
@@ -476,10 +560,13 @@ def _kernel_checks(knl: Kernel, sticking: bool, sliding: Kernel | None = None):
     an identity or a multiple of a residual already proven zero; that keeps
     every check exact and fast."""
     tag = knl.name
-    out = [(f"{tag}: the closed forms satisfy the six equations",
-            _six_equations_hold(knl, sticking))]
-    out.append((f"{tag}: dV1, dV2 are |V1 - v1|, |V2 - v2|",
-                f.delta_v_magnitudes_hold(lambda x: _expanded(knl, x, frozenset({Pn, Pt})))))
+    out = [(f"{tag}: the closed forms satisfy the six equations", _six_equations_hold(knl, sticking))]
+    out.append(
+        (
+            f"{tag}: dV1, dV2 are |V1 - v1|, |V2 - v2|",
+            f.delta_v_magnitudes_hold(lambda x: _expanded(knl, x, frozenset({Pn, Pt}))),
+        )
+    )
     g0 = tuple(c.xreplace({dvx: v2x - v1x, dvy: v2y - v1y}) for c in relative_velocity())
     gn0, gt0 = f.to_impact_frame(*g0)
     wr0 = w2 - w1
@@ -487,40 +574,65 @@ def _kernel_checks(knl: Kernel, sticking: bool, sliding: Kernel | None = None):
     # the components on the mean relative velocity (conventions.md, Energy).
     px, py = (knl.expanded(x, KEEP | {Pn, Pt}) for x in (Px, Py))
     lever = _cross_products(knl)
-    free = {V1x: v1x + k1 * px, V1y: v1y + k1 * py, V2x: v2x - k2 * px, V2y: v2y - k2 * py,
-            W1: w1 + j1 * (lever[c1] + M), W2: w2 - j2 * (lever[c2] + M)}
+    free = {
+        V1x: v1x + k1 * px,
+        V1y: v1y + k1 * py,
+        V2x: v2x - k2 * px,
+        V2y: v2y - k2 * py,
+        W1: w1 + j1 * (lever[c1] + M),
+        W2: w2 - j2 * (lever[c2] + M),
+    }
     _, rel = six_equation_residuals({**free, Px: px, Py: py, M: M}, sticking)
     Gn, Gt = f.to_impact_frame(*rel)
-    ke = [(vx**2 + vy**2) / (2 * k) + w**2 / (2 * j)
-          for vx, vy, w, k, j in ((v1x, v1y, w1, k1, j1), (v2x, v2y, w2, k2, j2))]
-    KE = [(free[a]**2 + free[b]**2) / (2 * k) + free[c]**2 / (2 * j)
-          for a, b, c, k, j in ((V1x, V1y, W1, k1, j1), (V2x, V2y, W2, k2, j2))]
+    ke = [
+        (vx**2 + vy**2) / (2 * k) + w**2 / (2 * j)
+        for vx, vy, w, k, j in ((v1x, v1y, w1, k1, j1), (v2x, v2y, w2, k2, j2))
+    ]
+    KE = [
+        (free[a] ** 2 + free[b] ** 2) / (2 * k) + free[c] ** 2 / (2 * j)
+        for a, b, c, k, j in ((V1x, V1y, W1, k1, j1), (V2x, V2y, W2, k2, j2))
+    ]
     work = Pn * (gn0 + Gn) / 2 + Pt * (gt0 + Gt) / 2 + M * (wr0 + free[W2] - free[W1]) / 2
-    out.append((f"{tag}: kinetic energy lost = work of Pn, Pt, M (any impulse)",
-                _zero(sum(ke) - sum(KE) - work)))
+    out.append(
+        (f"{tag}: kinetic energy lost = work of Pn, Pt, M (any impulse)", _zero(sum(ke) - sum(KE) - work))
+    )
     # The kernel's parts, with (Pn, Pt) free and M the kernel's M(Pn, Pt).
     at = frozenset({Pn, Pt})
     m_k = _expanded(knl, M, at)
     Gn_k, Gt_k, Wr_k = (x.xreplace({M: m_k}) for x in (Gn, Gt, free[W2] - free[W1]))
     restitution = Gn_k + e * gn0
     slip = Gt_k if sticking else 0
-    out.append((f"{tag}: TLn, TLt, TLm are those works given restitution"
-                + (" and zero final slip" if sticking else ""),
-                _zero(_expanded(knl, TLn, at) - Pn * (gn0 + Gn_k) / 2 + Pn * restitution / 2)
-                and _zero(_expanded(knl, TLt, at) - Pt * (gt0 + Gt_k) / 2 + Pt * slip / 2)
-                and _zero(_expanded(knl, TLm, at) - m_k * (wr0 + Wr_k) / 2)
-                and knl.expanded(TL, frozenset({TLn, TLt, TLm})) == TLn + TLt + TLm))
+    out.append(
+        (
+            f"{tag}: TLn, TLt, TLm are those works given restitution"
+            + (" and zero final slip" if sticking else ""),
+            _zero(_expanded(knl, TLn, at) - Pn * (gn0 + Gn_k) / 2 + Pn * restitution / 2)
+            and _zero(_expanded(knl, TLt, at) - Pt * (gt0 + Gt_k) / 2 + Pt * slip / 2)
+            and _zero(_expanded(knl, TLm, at) - m_k * (wr0 + Wr_k) / 2)
+            and knl.expanded(TL, frozenset({TLn, TLt, TLm})) == TLn + TLt + TLm,
+        )
+    )
     if sticking:
-        out.append((f"{tag}: Cramer's c1, c2, cd equal r1, r2, r1 - r2 x P of the sticking impulse",
-                    _cramer_levers(knl)))
-        out.append((f"{tag}: equals the sliding kernel at mu = mu_c",
-                    _sticking_is_sliding_at_critical(knl, sliding)))
+        out.append(
+            (
+                f"{tag}: Cramer's c1, c2, cd equal r1, r2, r1 - r2 x P of the sticking impulse",
+                _cramer_levers(knl),
+            )
+        )
+        out.append(
+            (f"{tag}: equals the sliding kernel at mu = mu_c", _sticking_is_sliding_at_critical(knl, sliding))
+        )
     else:
-        out.append((f"{tag}: mu = mu_c makes the final tangential relative velocity vanish",
-                    _critical_ratio_ends_slip(knl, Gt_k)))
+        out.append(
+            (
+                f"{tag}: mu = mu_c makes the final tangential relative velocity vanish",
+                _critical_ratio_ends_slip(knl, Gt_k),
+            )
+        )
         got = {sym: knl.expanded(sym, KEEP) for sym in (V1x, V1y, V2x, V2y)}
-        out.append((f"{tag}: zero lever arms reduce to the particle model, eqs 10-13",
-                    _reduces_to_particle(got)))
+        out.append(
+            (f"{tag}: zero lever arms reduce to the particle model, eqs 10-13", _reduces_to_particle(got))
+        )
     return out
 
 
@@ -531,30 +643,38 @@ def _cramer_levers(stick: Kernel) -> bool:
     atoms = frozenset({r1n, r1t, r2n, r2t, kk, wa, wb, wc, bn, bt, drn, drt, r12, D})
     frame = {drn: r1n - r2n, drt: r1t - r2t, r12: r1n * r2t - r1t * r2n}
     keff = {k: v.xreplace(frame) for k, v in effective_compliance().items()}
-    det = (keff[Knn] * keff[Ktt] - keff[Knt]**2)
+    det = keff[Knn] * keff[Ktt] - keff[Knt] ** 2
     sub = {**frame, D: det}
 
     def at_atoms(sym):
         return stick.expanded(sym, atoms).xreplace(keff).xreplace(sub)
 
     pn, pt = at_atoms(Pn), at_atoms(Pt)
-    return all(sp.simplify(at_atoms(c) - _cross(rn, rt, pn, pt)) == 0
-               for c, rn, rt in ((c1, r1n, r1t), (c2, r2n, r2t), (cd, r1n - r2n, r1t - r2t)))
+    return all(
+        sp.simplify(at_atoms(c) - _cross(rn, rt, pn, pt)) == 0
+        for c, rn, rt in ((c1, r1n, r1t), (c2, r2n, r2t), (cd, r1n - r2n, r1t - r2t))
+    )
 
 
 def _sticking_is_sliding_at_critical(stick: Kernel, slide: Kernel) -> bool:
     """Same finals as functions of (Pn, Pt), and the same (Pn, Pt) at μ = μ_c
     (an identity in K, bn, bt)."""
     at = frozenset({Pn, Pt})
-    same_finals = all(sp.expand(_expanded(stick, o, at) - _expanded(slide, o, at)) == 0
-                      for o in (V1x, V1y, W1, V2x, V2y, W2, M))
+    same_finals = all(
+        sp.expand(_expanded(stick, o, at) - _expanded(slide, o, at)) == 0
+        for o in (V1x, V1y, W1, V2x, V2y, W2, M)
+    )
     stick_atoms, lemma = _small_atoms(True)
     slide_atoms = _small_atoms(False)[0] | {bn, bt}
     crit = {mu: slide.expanded(mu_c, slide_atoms)}
     same_impulse = all(
-        sp.simplify(stick.expanded(o, stick_atoms | {bn, bt}).xreplace(lemma)
-                    - slide.expanded(o, slide_atoms).xreplace(crit)) == 0
-        for o in (Pn, Pt))
+        sp.simplify(
+            stick.expanded(o, stick_atoms | {bn, bt}).xreplace(lemma)
+            - slide.expanded(o, slide_atoms).xreplace(crit)
+        )
+        == 0
+        for o in (Pn, Pt)
+    )
     return same_finals and same_impulse
 
 
@@ -572,8 +692,10 @@ def _reduces_to_particle(got) -> bool:
     zero_arms = {r1x: 0, r1y: 0, r2x: 0, r2y: 0}
     printed = particle.seed_printed_solution(sticking=False)
     vals = particle._seed_frame_values()
-    for (sx, sy), (sn, st) in (((V1x, V1y), (particle.V1n, particle.V1t)),
-                               ((V2x, V2y), (particle.V2n, particle.V2t))):
+    for (sx, sy), (sn, st) in (
+        ((V1x, V1y), (particle.V1n, particle.V1t)),
+        ((V2x, V2y), (particle.V2n, particle.V2t)),
+    ):
         fn, ft = f.to_impact_frame(got[sx].xreplace(zero_arms), got[sy].xreplace(zero_arms))
         if not (_zero(fn - printed[sn].xreplace(vals)) and _zero(ft - printed[st].xreplace(vals))):
             return False
@@ -589,16 +711,23 @@ def _specialised_checks():
     for base in KERNELS:
         general = by_name[base.name]
         no_moment = by_name[f"{base.name}_em1"]
-        same = all(_zero(no_moment.expanded(o, KEEP)
-                         - general.expanded(o, KEEP).xreplace({e_m: 1}))
-                   for o in no_moment.outputs)
-        out.append((f"{no_moment.name}: M = TLm = 0 and the other outputs are "
-                    f"{base.name}'s at e_m = 1",
-                    dict(no_moment.constants) == {"M": 0.0, "TLm": 0.0} and same))
+        same = all(
+            _zero(no_moment.expanded(o, KEEP) - general.expanded(o, KEEP).xreplace({e_m: 1}))
+            for o in no_moment.outputs
+        )
+        out.append(
+            (
+                f"{no_moment.name}: M = TLm = 0 and the other outputs are {base.name}'s at e_m = 1",
+                dict(no_moment.constants) == {"M": 0.0, "TLm": 0.0} and same,
+            )
+        )
         for full in (general, no_moment):
-            out.append((f"{full.name}: every output tier computes the full kernel's formulas",
-                        all(_same_formulas(by_name[f"{full.name}_{tier}"], full)
-                            for tier in specialise.TIERS)))
+            out.append(
+                (
+                    f"{full.name}: every output tier computes the full kernel's formulas",
+                    all(_same_formulas(by_name[f"{full.name}_{tier}"], full) for tier in specialise.TIERS),
+                )
+            )
     return out
 
 

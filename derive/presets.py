@@ -92,47 +92,61 @@ COEFFICIENTS = {"restitution": e, "impulse_ratio": mu, "moment_restitution": e_m
 
 _COMMON_VELOCITY = {"restitution": 0.0, "impulse_ratio": "critical", "moment_restitution": 1.0}
 _GENERAL = {
-    "kernel": "rigid", "fixed": {}, "required": ("restitution", "impulse_ratio"),
+    "kernel": "rigid",
+    "fixed": {},
+    "required": ("restitution", "impulse_ratio"),
     "optional": {"moment_restitution": 1.0},
     "assumptions": "Brach's general planar rigid-body model (seed appendix): restitution e, "
-                   "impulse ratio mu (a number, or \"critical\" for no sliding at separation) "
-                   "and moment restitution e_m (default 1: no moment impulse) from the scene.",
+    'impulse ratio mu (a number, or "critical" for no sliding at separation) '
+    "and moment restitution e_m (default 1: no moment impulse) from the scene.",
 }
 
 PRESETS = {
     "rigid": _GENERAL,
     "brach": _GENERAL,
     "particle": {
-        "kernel": "particle", "fixed": {}, "required": ("restitution", "impulse_ratio"),
+        "kernel": "particle",
+        "fixed": {},
+        "required": ("restitution", "impulse_ratio"),
         "optional": {},
         "assumptions": "Two particles (seed eqs 1-18): no yaw and no lever arms; restitution e "
-                       "and impulse ratio mu from the scene.",
+        "and impulse ratio mu from the scene.",
     },
     "limpert": {
-        "kernel": "rigid", "fixed": _COMMON_VELOCITY, "required": (), "optional": {},
+        "kernel": "rigid",
+        "fixed": _COMMON_VELOCITY,
+        "required": (),
+        "optional": {},
         "assumptions": "Limpert: perfectly inelastic (e = 0), a common velocity at the impact "
-                       "centre at separation (mu = mu_c: sliding ends, so not for sideswipes) and "
-                       "no moment impulse (e_m = 1); seed Table 3.",
+        "centre at separation (mu = mu_c: sliding ends, so not for sideswipes) and "
+        "no moment impulse (e_m = 1); seed Table 3.",
     },
     "macmillan": {
-        "kernel": "rigid", "fixed": {"moment_restitution": 1.0},
-        "required": ("restitution", "impulse_ratio"), "optional": {},
+        "kernel": "rigid",
+        "fixed": {"moment_restitution": 1.0},
+        "required": ("restitution", "impulse_ratio"),
+        "optional": {},
         "assumptions": "Macmillan: restitution e and impulse ratio mu = Pt/Pn from the scene, "
-                       "no moment impulse (e_m = 1); seed Table 4.",
+        "no moment impulse (e_m = 1); seed Table 4.",
     },
     "impac": {
-        "kernel": "rigid", "fixed": _COMMON_VELOCITY, "required": (), "optional": {},
+        "kernel": "rigid",
+        "fixed": _COMMON_VELOCITY,
+        "required": (),
+        "optional": {},
         "assumptions": "Woolley's IMPAC, common-velocity constraint: the same velocity at the "
-                       "impact centre after the exchange of momentum (e = 0, mu = mu_c) and no "
-                       "moment impulse (e_m = 1); seed Tables 5-7.",
+        "impact centre after the exchange of momentum (e = 0, mu = mu_c) and no "
+        "moment impulse (e_m = 1); seed Tables 5-7.",
     },
     "impac_sideswipe": {
-        "kernel": "impac_sideswipe", "fixed": {"restitution": 0.0, "moment_restitution": 1.0},
-        "required": (), "optional": {"slip": 0.0},
+        "kernel": "impac_sideswipe",
+        "fixed": {"restitution": 0.0, "moment_restitution": 1.0},
+        "required": (),
+        "optional": {"slip": 0.0},
         "assumptions": "Woolley's IMPAC, sideswipe constraint: no normal restitution (e = 0), the "
-                       "final tangential relative velocity at the impact centre is `slip` times the "
-                       "initial one (default 0, the common-velocity solution), no moment impulse "
-                       "(e_m = 1).",
+        "final tangential relative velocity at the impact centre is `slip` times the "
+        "initial one (default 0, the common-velocity solution), no moment impulse "
+        "(e_m = 1).",
     },
 }
 
@@ -152,12 +166,13 @@ def _frame_blocks():
     gx_, gy_ = planar.relative_velocity()
     gn_, gt_ = f.to_impact_frame(gx, gy)
     return (
-        Block(f.inverse_masses((m1, m2, I1, I2), (k1, k2, j1, j2)) + f.normal_components()
-              + ((dvx, v2x - v1x), (dvy, v2y - v1y), (r12, r1x * r2y - r1y * r2x)),
-              Guard((sp.StrictGreaterThan(k1 + k2, 0), sp.StrictGreaterThan(j1 + j2, 0)),
-                    "SINGULAR")),
-        Block(((r1n, r1n_), (r1t, r1t_), (r2n, r2n_), (r2t, r2t_), (gx, gx_), (gy, gy_),
-               (kk, k1 + k2))),
+        Block(
+            f.inverse_masses((m1, m2, I1, I2), (k1, k2, j1, j2))
+            + f.normal_components()
+            + ((dvx, v2x - v1x), (dvy, v2y - v1y), (r12, r1x * r2y - r1y * r2x)),
+            Guard((sp.StrictGreaterThan(k1 + k2, 0), sp.StrictGreaterThan(j1 + j2, 0)), "SINGULAR"),
+        ),
+        Block(((r1n, r1n_), (r1t, r1t_), (r2n, r2n_), (r2t, r2t_), (gx, gx_), (gy, gy_), (kk, k1 + k2))),
         Block(((gn, gn_), (gt, gt_)), f.approach_guard()),
     )
 
@@ -166,15 +181,26 @@ def _impulse_blocks():
     """K (Pn, Pt) = (bn, bt) = (gn, (1 - slip)·gt): Gn = 0 and Gt = slip·gt, by
     Cramer's rule. μ_c is the ratio of the same scene's slip = 0 (common-velocity)
     impulse."""
-    keff = {k: v.xreplace(NO_MOMENT) for k, v in planar.effective_compliance().items()
-            if k in (Knn, Knt, Ktt)}
+    keff = {
+        k: v.xreplace(NO_MOMENT) for k, v in planar.effective_compliance().items() if k in (Knn, Knt, Ktt)
+    }
     return (
-        Block(tuple(keff.items()) + ((D, planar.effective_determinant().xreplace(NO_MOMENT)),
-                                     (bn, gn), (bt, (1 - slip) * gt))),
-        Block(((Dc, Ktt * bn - Knt * bt), (Dcrit, Ktt * bn - Knt * gt)),
-              Guard((sp.Ne(D, 0), sp.Ne(Dc, 0), sp.Ne(Dcrit, 0)), "SINGULAR")),
-        Block(((Pn, Dc / D), (Pt, (Knn * bt - Knt * bn) / D),
-               (mu_used, (Knn * bt - Knt * bn) / Dc), (mu_c, (Knn * gt - Knt * bn) / Dcrit))),
+        Block(
+            tuple(keff.items())
+            + ((D, planar.effective_determinant().xreplace(NO_MOMENT)), (bn, gn), (bt, (1 - slip) * gt))
+        ),
+        Block(
+            ((Dc, Ktt * bn - Knt * bt), (Dcrit, Ktt * bn - Knt * gt)),
+            Guard((sp.Ne(D, 0), sp.Ne(Dc, 0), sp.Ne(Dcrit, 0)), "SINGULAR"),
+        ),
+        Block(
+            (
+                (Pn, Dc / D),
+                (Pt, (Knn * bt - Knt * bn) / D),
+                (mu_used, (Knn * bt - Knt * bn) / Dc),
+                (mu_c, (Knn * gt - Knt * bn) / Dcrit),
+            )
+        ),
     )
 
 
@@ -187,12 +213,29 @@ def _final_blocks():
     px, py = f.to_scene_frame(Pn, Pt)
     lever1, lever2 = (x.xreplace(NO_MOMENT) for x in planar.lever_products_sticking()[:2])
     return (
-        Block(((Px, px), (Py, py), (c1, lever1), (c2, lever2), (M, sp.Integer(0)),
-               *f.delta_v_magnitudes(),
-               (TLn, Pn * gn / 2), (TLt, Pt * (1 + slip) * gt / 2))),
-        Block(((V1x, v1x + k1 * Px), (V1y, v1y + k1 * Py), (V2x, v2x - k2 * Px),
-               (V2y, v2y - k2 * Py), (W1, w1 + j1 * c1), (W2, w2 - j2 * c2),
-               (TLm, sp.Integer(0)))),
+        Block(
+            (
+                (Px, px),
+                (Py, py),
+                (c1, lever1),
+                (c2, lever2),
+                (M, sp.Integer(0)),
+                *f.delta_v_magnitudes(),
+                (TLn, Pn * gn / 2),
+                (TLt, Pt * (1 + slip) * gt / 2),
+            )
+        ),
+        Block(
+            (
+                (V1x, v1x + k1 * Px),
+                (V1y, v1y + k1 * Py),
+                (V2x, v2x - k2 * Px),
+                (V2y, v2y - k2 * Py),
+                (W1, w1 + j1 * c1),
+                (W2, w2 - j2 * c2),
+                (TLm, sp.Integer(0)),
+            )
+        ),
         Block(((TL, TLn + TLt),)),
     )
 
@@ -205,11 +248,13 @@ def sideswipe_kernel() -> Kernel:
     return Kernel(
         name="impac_sideswipe",
         doc="IMPAC sideswipe constraint (Woolley): e = 0, final tangential slip at the impact "
-            "centre = slip times the initial one, no moment impulse.",
+        "centre = slip times the initial one, no moment impulse.",
         inputs=INPUTS,
-        checks=(finite_inputs(scalars, (m1, m2, I1, I2)), positive_or_fixed((m1, m2, I1, I2)),
-                Guard((sp.Eq(IsFinite(m1), IsFinite(I1)), sp.Eq(IsFinite(m2), IsFinite(I2))),
-                      "BAD_MASS")),
+        checks=(
+            finite_inputs(scalars, (m1, m2, I1, I2)),
+            positive_or_fixed((m1, m2, I1, I2)),
+            Guard((sp.Eq(IsFinite(m1), IsFinite(I1)), sp.Eq(IsFinite(m2), IsFinite(I2))), "BAD_MASS"),
+        ),
         blocks=_frame_blocks() + _impulse_blocks() + _final_blocks() + (tolerances,),
         outputs=planar.OUTPUTS,
         flags=flags,
@@ -242,8 +287,9 @@ def _final_relative_velocity(knl: Kernel, fix: dict):
     """(Gn, Gt) at separation from the kernel's finals with (Pn, Pt) free, and
     the residuals of the momentum, angular-impulse and moment-restitution
     equations (fix: the coefficient values the preset holds fixed)."""
-    free = {sym: _with_levers(knl, sym, {Pn, Pt}).xreplace(fix)
-            for sym in (V1x, V1y, W1, V2x, V2y, W2, M, Px, Py)}
+    free = {
+        sym: _with_levers(knl, sym, {Pn, Pt}).xreplace(fix) for sym in (V1x, V1y, W1, V2x, V2y, W2, M, Px, Py)
+    }
     res, rel = planar.six_equation_residuals(free, sticking=False)
     return f.to_impact_frame(*rel), [r.xreplace(fix) for r in res[:6] + res[7:8]], free
 
@@ -251,10 +297,10 @@ def _final_relative_velocity(knl: Kernel, fix: dict):
 def _compliance_lemma(knl: Kernel, fix: dict, G) -> bool:
     """G = g - K (Pn, Pt) - h for any impulse, with K, h, g the kernel's."""
     kx = {s: knl.expanded(s, KEEP).xreplace(fix) for s in (Knn, Knt, Ktt, gn, gt)}
-    h = {s: (knl.expanded(s, KEEP).xreplace(fix) if s in knl.definitions() else 0)
-         for s in (hn, ht)}
-    return (_zero(G[0] - (kx[gn] - kx[Knn] * Pn - kx[Knt] * Pt - h[hn]))
-            and _zero(G[1] - (kx[gt] - kx[Knt] * Pn - kx[Ktt] * Pt - h[ht])))
+    h = {s: (knl.expanded(s, KEEP).xreplace(fix) if s in knl.definitions() else 0) for s in (hn, ht)}
+    return _zero(G[0] - (kx[gn] - kx[Knn] * Pn - kx[Knt] * Pt - h[hn])) and _zero(
+        G[1] - (kx[gt] - kx[Knt] * Pn - kx[Ktt] * Pt - h[ht])
+    )
 
 
 def _impulse_in_atoms(knl: Kernel, fix: dict):
@@ -265,8 +311,9 @@ def _impulse_in_atoms(knl: Kernel, fix: dict):
 
 def _fixed_values(name: str) -> dict:
     """The preset's fixed numeric coefficients as kernel-symbol substitutions."""
-    return {COEFFICIENTS[k]: sp.nsimplify(v) for k, v in PRESETS[name]["fixed"].items()
-            if k != "impulse_ratio"}
+    return {
+        COEFFICIENTS[k]: sp.nsimplify(v) for k, v in PRESETS[name]["fixed"].items() if k != "impulse_ratio"
+    }
 
 
 def _common_velocity_claims(name: str):
@@ -278,29 +325,36 @@ def _common_velocity_claims(name: str):
     G, residuals, free = _final_relative_velocity(knl, fix)
     no_h = all(sp.simplify(knl.expanded(s, KEEP).xreplace(fix)) == 0 for s in (hn, ht))
     pn, pt = _impulse_in_atoms(knl, {**fix, hn: 0, ht: 0})
-    common = (sp.simplify(gn - Knn * pn - Knt * pt) == 0
-              and sp.simplify(gt - Knt * pn - Ktt * pt) == 0)
-    return [(f"{name}: {knl.name} at {fix} has M = 0 and Gn = Gt = 0 "
-             "(common velocity at the impact centre)",
-             knl.name == "rigid_critical" and _zero(free[M]) and no_h
-             and all(_zero(r) for r in residuals) and _compliance_lemma(knl, fix, G) and common)]
+    common = sp.simplify(gn - Knn * pn - Knt * pt) == 0 and sp.simplify(gt - Knt * pn - Ktt * pt) == 0
+    return [
+        (
+            f"{name}: {knl.name} at {fix} has M = 0 and Gn = Gt = 0 (common velocity at the impact centre)",
+            knl.name == "rigid_critical"
+            and _zero(free[M])
+            and no_h
+            and all(_zero(r) for r in residuals)
+            and _compliance_lemma(knl, fix, G)
+            and common,
+        )
+    ]
 
 
 def _macmillan_claims():
     """Macmillan: the rigid kernels at its fixed e_m = 1 have no moment impulse,
     for any impulse."""
     fix = _fixed_values("macmillan")
-    ok = all(_zero(_with_levers(knl, M, {Pn, Pt}).xreplace(fix))
-             and all(_zero(r) for r in _final_relative_velocity(knl, fix)[1])
-             for knl in planar.KERNELS)
+    ok = all(
+        _zero(_with_levers(knl, M, {Pn, Pt}).xreplace(fix))
+        and all(_zero(r) for r in _final_relative_velocity(knl, fix)[1])
+        for knl in planar.KERNELS
+    )
     return [("macmillan: rigid and rigid_critical at e_m = 1 have M = 0", ok)]
 
 
 def _table_claims():
     """Every preset names an emitted kernel family, and its fixed, required and
     optional coefficients are exactly that family's coefficient inputs."""
-    families = {"rigid": planar.KERNELS, "particle": particle.KERNELS,
-                "impac_sideswipe": KERNELS}
+    families = {"rigid": planar.KERNELS, "particle": particle.KERNELS, "impac_sideswipe": KERNELS}
     ok = True
     for row in PRESETS.values():
         knls = families[row["kernel"]]
@@ -321,33 +375,58 @@ def _sideswipe_claims():
     # The kernel was derived at its preset's e = 0, e_m = 1 (it has neither input).
     G, residuals, free = _final_relative_velocity(knl, _fixed_values(tag))
     pn, pt = _impulse_in_atoms(knl, {})
-    constraints = (sp.simplify(gn - Knn * pn - Knt * pt) == 0
-                   and sp.simplify(gt - Knt * pn - Ktt * pt - slip * gt) == 0)
+    constraints = (
+        sp.simplify(gn - Knn * pn - Knt * pt) == 0 and sp.simplify(gt - Knt * pn - Ktt * pt - slip * gt) == 0
+    )
     det = _zero(knl.expanded(D, KEEP) - knl.expanded(Knn * Ktt - Knt**2, KEEP))
     back = f.to_impact_frame(free[Px], free[Py])
-    out = [(f"{tag}: momentum, angular impulse and M = 0 hold; Gn = 0 and Gt = slip*gt",
-            _zero(free[M]) and all(_zero(r) for r in residuals) and _compliance_lemma(knl, {}, G)
-            and constraints and det and _zero(back[0] - Pn) and _zero(back[1] - Pt))]
-    out.append((f"{tag}: dV1, dV2 are |V1 - v1|, |V2 - v2|",
-                f.delta_v_magnitudes_hold(lambda x: knl.expanded(x, KEEP | {Pn, Pt}))))
+    out = [
+        (
+            f"{tag}: momentum, angular impulse and M = 0 hold; Gn = 0 and Gt = slip*gt",
+            _zero(free[M])
+            and all(_zero(r) for r in residuals)
+            and _compliance_lemma(knl, {}, G)
+            and constraints
+            and det
+            and _zero(back[0] - Pn)
+            and _zero(back[1] - Pt),
+        )
+    ]
+    out.append(
+        (
+            f"{tag}: dV1, dV2 are |V1 - v1|, |V2 - v2|",
+            f.delta_v_magnitudes_hold(lambda x: knl.expanded(x, KEEP | {Pn, Pt})),
+        )
+    )
     # Energy: for any (Pn, Pt) the kinetic energy lost is the work on the mean
     # relative velocity; with Gn = 0 and Gt = slip*gt that is TLn + TLt.
     gn0, gt0 = (knl.expanded(s, KEEP) for s in (gn, gt))
-    ke = [(vx**2 + vy**2) / (2 * k) + w**2 / (2 * j)
-          for vx, vy, w, k, j in ((v1x, v1y, w1, k1, j1), (v2x, v2y, w2, k2, j2))]
-    KE = [(free[a]**2 + free[b]**2) / (2 * k) + free[c]**2 / (2 * j)
-          for a, b, c, k, j in ((V1x, V1y, W1, k1, j1), (V2x, V2y, W2, k2, j2))]
+    ke = [
+        (vx**2 + vy**2) / (2 * k) + w**2 / (2 * j)
+        for vx, vy, w, k, j in ((v1x, v1y, w1, k1, j1), (v2x, v2y, w2, k2, j2))
+    ]
+    KE = [
+        (free[a] ** 2 + free[b] ** 2) / (2 * k) + free[c] ** 2 / (2 * j)
+        for a, b, c, k, j in ((V1x, V1y, W1, k1, j1), (V2x, V2y, W2, k2, j2))
+    ]
     work = Pn * (gn0 + G[0]) / 2 + Pt * (gt0 + G[1]) / 2
     at = KEEP | {Pn, Pt}
-    out.append((f"{tag}: kinetic energy lost = TLn + TLt, the work of Pn and Pt",
-                _zero(sum(ke) - sum(KE) - work)
-                and _zero(knl.expanded(TLn, at) - Pn * (gn0 + 0) / 2)
-                and _zero(knl.expanded(TLt, at) - Pt * (gt0 + slip * gt0) / 2)
-                and sp.expand(knl.expanded(TL - TLn - TLt, at)) == 0))
-    out.append((f"{tag}: the Cramer lever products equal r_i x P at its impulse",
-                _cramer_levers(knl)))
-    out.append((f"{tag}: slip = 0 equals rigid_critical at e = 0, e_m = 1 (common velocity)",
-                _sideswipe_is_common_velocity(knl)))
+    out.append(
+        (
+            f"{tag}: kinetic energy lost = TLn + TLt, the work of Pn and Pt",
+            _zero(sum(ke) - sum(KE) - work)
+            and _zero(knl.expanded(TLn, at) - Pn * (gn0 + 0) / 2)
+            and _zero(knl.expanded(TLt, at) - Pt * (gt0 + slip * gt0) / 2)
+            and sp.expand(knl.expanded(TL - TLn - TLt, at)) == 0,
+        )
+    )
+    out.append((f"{tag}: the Cramer lever products equal r_i x P at its impulse", _cramer_levers(knl)))
+    out.append(
+        (
+            f"{tag}: slip = 0 equals rigid_critical at e = 0, e_m = 1 (common velocity)",
+            _sideswipe_is_common_velocity(knl),
+        )
+    )
     return out
 
 
@@ -362,30 +441,41 @@ def _cramer_levers(knl: Kernel) -> bool:
 
     sub[D] = sp.expand(at_atoms(Knn * Ktt - Knt**2))
     pn, pt = at_atoms(Pn).xreplace(sub), at_atoms(Pt).xreplace(sub)
-    return all(sp.simplify(at_atoms(c).xreplace(sub) - planar._cross(rn, rt, pn, pt)) == 0
-               for c, rn, rt in ((c1, r1n, r1t), (c2, r2n, r2t)))
+    return all(
+        sp.simplify(at_atoms(c).xreplace(sub) - planar._cross(rn, rt, pn, pt)) == 0
+        for c, rn, rt in ((c1, r1n, r1t), (c2, r2n, r2t))
+    )
 
 
 def _sideswipe_is_common_velocity(knl: Kernel) -> bool:
     """Same K, g, det K; same finals as functions of (Pn, Pt); same (Pn, Pt, μ_c)."""
     crit = planar.KERNELS[1]
     fix = {e: 0, e_m: 1}
-    same_atoms = all(_zero(knl.expanded(s, KEEP) - crit.expanded(s, KEEP).xreplace(fix))
-                     for s in (Knn, Knt, Ktt, gn, gt, D))
-    same_finals = all(_zero(_with_levers(knl, o, {Pn, Pt})
-                            - _with_levers(crit, o, {Pn, Pt}).xreplace(fix))
-                      for o in (V1x, V1y, W1, V2x, V2y, W2, M))
+    same_atoms = all(
+        _zero(knl.expanded(s, KEEP) - crit.expanded(s, KEEP).xreplace(fix))
+        for s in (Knn, Knt, Ktt, gn, gt, D)
+    )
+    same_finals = all(
+        _zero(_with_levers(knl, o, {Pn, Pt}) - _with_levers(crit, o, {Pn, Pt}).xreplace(fix))
+        for o in (V1x, V1y, W1, V2x, V2y, W2, M)
+    )
     no_h = all(sp.simplify(crit.expanded(s, KEEP).xreplace(fix)) == 0 for s in (hn, ht))
     atoms = ATOMS | {hn, ht}
     crit_fix = {**fix, hn: 0, ht: 0}
     same_impulse = all(
-        sp.simplify(knl.expanded(s, atoms).xreplace({slip: 0})
-                    - crit.expanded(s, atoms).xreplace(crit_fix)) == 0
-        for s in (Pn, Pt, mu_c))
+        sp.simplify(knl.expanded(s, atoms).xreplace({slip: 0}) - crit.expanded(s, atoms).xreplace(crit_fix))
+        == 0
+        for s in (Pn, Pt, mu_c)
+    )
     return same_atoms and same_finals and no_h and same_impulse
 
 
 def proofs():
     """(claim, passed) pairs for the preset table and the sideswipe kernel."""
-    return (_table_claims() + _common_velocity_claims("limpert")
-            + _common_velocity_claims("impac") + _macmillan_claims() + _sideswipe_claims())
+    return (
+        _table_claims()
+        + _common_velocity_claims("limpert")
+        + _common_velocity_claims("impac")
+        + _macmillan_claims()
+        + _sideswipe_claims()
+    )

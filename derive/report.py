@@ -31,12 +31,15 @@ KERNELS = (
         name="kinetic_energy",
         doc="Kinetic energy of the pair, translational plus yaw; a fixed body contributes 0.",
         inputs=(m1, m2, I1, I2, v1x, v1y, w1, v2x, v2y, w2),
-        checks=(finite_inputs((v1x, v1y, w1, v2x, v2y, w2), (m1, m2, I1, I2)),
-                positive_or_fixed((m1, m2)),
-                Guard(tuple(sp.GreaterThan(sp.Symbol(i.name), 0) for i in (I1, I2)), "BAD_MASS")),
-        blocks=(Block(((T1, _body_energy(m1, I1, v1x, v1y, w1)),
-                       (T2, _body_energy(m2, I2, v2x, v2y, w2)))),
-                Block(((T, T1 + T2),))),
+        checks=(
+            finite_inputs((v1x, v1y, w1, v2x, v2y, w2), (m1, m2, I1, I2)),
+            positive_or_fixed((m1, m2)),
+            Guard(tuple(sp.GreaterThan(sp.Symbol(i.name), 0) for i in (I1, I2)), "BAD_MASS"),
+        ),
+        blocks=(
+            Block(((T1, _body_energy(m1, I1, v1x, v1y, w1)), (T2, _body_energy(m2, I2, v2x, v2y, w2)))),
+            Block(((T, T1 + T2),)),
+        ),
         outputs=(T, T1, T2),
     ),
 )
@@ -49,6 +52,10 @@ def proofs():
     total = knl.expanded(T).xreplace(moving)
     expected = (m1 * (v1x**2 + v1y**2) + I1 * w1**2 + m2 * (v2x**2 + v2y**2) + I2 * w2**2) / 2
     fixed = knl.expanded(T1).xreplace({sp.Symbol(m1.name): sp.oo})
-    return [("kinetic_energy: T = sum of m |v|^2/2 + I w^2/2 for moving bodies",
-             sp.simplify(total - expected) == 0),
-            ("kinetic_energy: a fixed body (m = inf) contributes 0", fixed == 0)]
+    return [
+        (
+            "kinetic_energy: T = sum of m |v|^2/2 + I w^2/2 for moving bodies",
+            sp.simplify(total - expected) == 0,
+        ),
+        ("kinetic_energy: a fixed body (m = inf) contributes 0", fixed == 0),
+    ]

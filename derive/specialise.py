@@ -40,10 +40,11 @@ def normal_form(kernel: Kernel) -> Kernel:
     if defs.get(nx) != sp.cos(gamma) or defs.get(ny) != sp.sin(gamma):
         raise ValueError(f"{kernel.name}: the normal is not (cos gamma, sin gamma)")
     at = kernel.inputs.index(gamma)
-    inputs = kernel.inputs[:at] + (nx, ny) + kernel.inputs[at + 1:]
+    inputs = kernel.inputs[:at] + (nx, ny) + kernel.inputs[at + 1 :]
     checks = tuple(_replace_angle_check(g) for g in kernel.checks)
-    blocks = tuple(replace(b, assigns=tuple((s, x) for s, x in b.assigns if s not in (nx, ny)))
-                   for b in kernel.blocks)
+    blocks = tuple(
+        replace(b, assigns=tuple((s, x) for s, x in b.assigns if s not in (nx, ny))) for b in kernel.blocks
+    )
     return replace(kernel, inputs=inputs, checks=checks, blocks=blocks, angle=gamma)
 
 
@@ -73,20 +74,27 @@ def fix_inputs(kernel: Kernel, name: str, values: dict, doc: str) -> Kernel:
                 known[sym] = value
             else:
                 assigns.append((sym, value))
-        blocks.append(replace(block, assigns=tuple(assigns),
-                              guard=_fixed_guard(block.guard, known)))
+        blocks.append(replace(block, assigns=tuple(assigns), guard=_fixed_guard(block.guard, known)))
     outputs = tuple(s for s in kernel.outputs if s not in known)
     constants = kernel.constants + tuple(
-        (kernel.public_name(s), float(known[s])) for s in kernel.outputs if s in known)
-    flags = tuple((flag, tuple(c for c in (x.xreplace(known) for x in conds) if c is not sp.false))
-                  for flag, conds in kernel.flags)
+        (kernel.public_name(s), float(known[s])) for s in kernel.outputs if s in known
+    )
+    flags = tuple(
+        (flag, tuple(c for c in (x.xreplace(known) for x in conds) if c is not sp.false))
+        for flag, conds in kernel.flags
+    )
     fixed = replace(
-        kernel, name=name, doc=f"{kernel.doc} {doc}",
+        kernel,
+        name=name,
+        doc=f"{kernel.doc} {doc}",
         inputs=tuple(s for s in kernel.inputs if s not in values),
         checks=tuple(g for g in (_fixed_guard(g, known) for g in kernel.checks) if g),
-        blocks=tuple(blocks), outputs=outputs, constants=constants,
+        blocks=tuple(blocks),
+        outputs=outputs,
+        constants=constants,
         finite=tuple(s for s in kernel.finite_checked() if s not in known),
-        flags=tuple((flag, conds) for flag, conds in flags if conds))
+        flags=tuple((flag, conds) for flag, conds in flags if conds),
+    )
     return prune(fixed, name, fixed.output_names() + tuple(n for n, _ in constants))
 
 
@@ -131,9 +139,14 @@ def prune(kernel: Kernel, name: str, outputs: tuple[str, ...], doc: str = "") ->
             blocks.append(replace(block, assigns=assigns))
     computed = {s for b in blocks for s, _ in b.assigns}
     return replace(
-        kernel, name=name, doc=f"{kernel.doc} {doc}".rstrip(), blocks=tuple(reversed(blocks)),
-        outputs=keep, constants=tuple((n, v) for n, v in kernel.constants if n in outputs),
-        finite=tuple(s for s in kernel.finite_checked() if s in computed))
+        kernel,
+        name=name,
+        doc=f"{kernel.doc} {doc}".rstrip(),
+        blocks=tuple(reversed(blocks)),
+        outputs=keep,
+        constants=tuple((n, v) for n, v in kernel.constants if n in outputs),
+        finite=tuple(s for s in kernel.finite_checked() if s in computed),
+    )
 
 
 def _symbols(conditions) -> set:
@@ -145,5 +158,7 @@ def _symbols(conditions) -> set:
 
 def tiers(kernel: Kernel) -> tuple[Kernel, ...]:
     """The pruned kernels of every tier below "all", then `kernel` itself."""
-    return tuple(prune(kernel, f"{kernel.name}_{tier}", names, f"Outputs: {tier} only.")
-                 for tier, names in TIERS.items()) + (kernel,)
+    return tuple(
+        prune(kernel, f"{kernel.name}_{tier}", names, f"Outputs: {tier} only.")
+        for tier, names in TIERS.items()
+    ) + (kernel,)

@@ -68,10 +68,10 @@ SHIFT = 1.5 * 2.0**52
 # fdlibm's constants as IEEE bit patterns (e_rem_pio2.c, k_sin.c, k_cos.c).
 _FDLIBM_REDUCTION = {
     "INVPIO2": 0x3FE45F306DC9C883,  # 6.36619772367581382433e-01  2/π
-    "P1": 0x3FF921FB54400000,       # 1.57079632673412561417e+00  first 33 bits of π/2
-    "P2": 0x3DD0B4611A600000,       # 6.07710050630396597660e-11  second 33 bits
-    "P3": 0x3BA3198A2E000000,       # 2.02226624871116645580e-21  third 33 bits
-    "P3T": 0x397B839A252049C1,      # 8.47842766036889956997e-32  π/2 - (P1 + P2 + P3)
+    "P1": 0x3FF921FB54400000,  # 1.57079632673412561417e+00  first 33 bits of π/2
+    "P2": 0x3DD0B4611A600000,  # 6.07710050630396597660e-11  second 33 bits
+    "P3": 0x3BA3198A2E000000,  # 2.02226624871116645580e-21  third 33 bits
+    "P3T": 0x397B839A252049C1,  # 8.47842766036889956997e-32  π/2 - (P1 + P2 + P3)
 }
 _FDLIBM_SIN = (  # S1..S6: sin x ≈ x + S1 x^3 + ... + S6 x^13 on [-π/4, π/4]
     0xBFC5555555555549,  # -1.66666666666666324348e-01
@@ -109,8 +109,13 @@ def reduction_constants() -> dict[str, float]:
         p1 = _truncated(half_pi, 33)
         p2 = _truncated(half_pi - p1, 33)
         p3 = _truncated(half_pi - p1 - p2, 33)
-        return {"INVPIO2": float(2 / mpmath.pi), "P1": p1, "P2": p2, "P3": p3,
-                "P3T": float(half_pi - p1 - p2 - p3)}
+        return {
+            "INVPIO2": float(2 / mpmath.pi),
+            "P1": p1,
+            "P2": p2,
+            "P3": p3,
+            "P3T": float(half_pi - p1 - p2 - p3),
+        }
 
 
 SIN_COEFFICIENTS = tuple(_from_bits(b) for b in _FDLIBM_SIN)
@@ -189,6 +194,7 @@ def sincos_function():
 
 # ------------------------------------------------------------------ errors in ulps
 
+
 def ulp_of(ref) -> mpmath.mpf:
     """One unit in the last place of the double binade holding the exact value `ref`
     (2^-1074 in the subnormal range)."""
@@ -212,8 +218,9 @@ def ulp_errors(sincos, xs) -> tuple[float, float]:
     return worst_s, worst_c
 
 
-def near_quadrant_multiples(count: int, rng: random.Random, limit: float = SINCOS_LIMIT,
-                            step: float = 0.5) -> list[float]:
+def near_quadrant_multiples(
+    count: int, rng: random.Random, limit: float = SINCOS_LIMIT, step: float = 0.5
+) -> list[float]:
     """Doubles nearest to fn·step·π (step 0.5: multiples of π/2, 0.25: of π/4) and
     their neighbours, for fn spread over the range up to ``limit``: the hard cases of
     the reduction (cancellation) and of the quadrant choice (π/4 boundaries)."""
@@ -234,8 +241,14 @@ def proof_points(rng: random.Random) -> list[float]:
     tiny += [5e-324, -5e-324, 2.2250738585072014e-308, 1e-300, -1e-300]
     large = [rng.uniform(-SINCOS_LIMIT, SINCOS_LIMIT) for _ in range(400)]
     edges = [SINCOS_LIMIT, -SINCOS_LIMIT, 0.5 * SINCOS_LIMIT]
-    return (scene + tiny + large + edges + near_quadrant_multiples(300, rng)
-            + near_quadrant_multiples(100, rng, step=0.25))
+    return (
+        scene
+        + tiny
+        + large
+        + edges
+        + near_quadrant_multiples(300, rng)
+        + near_quadrant_multiples(100, rng, step=0.25)
+    )
 
 
 def _polynomial_errors() -> tuple[float, float]:
@@ -259,8 +272,13 @@ def _special_values_hold(sincos) -> bool:
         return (math.isnan(a) and math.isnan(b)) or (a == b and math.copysign(1, a) == math.copysign(1, b))
 
     nan = float("nan")
-    cases = ((0.0, (0.0, 1.0)), (-0.0, (-0.0, 1.0)), (math.inf, (nan, nan)),
-             (-math.inf, (nan, nan)), (nan, (nan, nan)))  # a dict would merge 0.0 and -0.0
+    cases = (
+        (0.0, (0.0, 1.0)),
+        (-0.0, (-0.0, 1.0)),
+        (math.inf, (nan, nan)),
+        (-math.inf, (nan, nan)),
+        (nan, (nan, nan)),
+    )  # a dict would merge 0.0 and -0.0
     return all(same(got, want) for x, expected in cases for got, want in zip(sincos(x), expected))
 
 
@@ -269,15 +287,23 @@ def proofs():
     sincos = sincos_function()
     poly_s, poly_c = _polynomial_errors()
     err_s, err_c = ulp_errors(sincos, proof_points(random.Random(20240611)))
-    ulp_claim = (f"sincos: max error vs 50-digit mpmath, ~3000 points, |x| <= {SINCOS_LIMIT:.4g}: "
-                 f"sin {err_s:.3f} ulp, cos {err_c:.3f} ulp (<= 1)")
+    ulp_claim = (
+        f"sincos: max error vs 50-digit mpmath, ~3000 points, |x| <= {SINCOS_LIMIT:.4g}: "
+        f"sin {err_s:.3f} ulp, cos {err_c:.3f} ulp (<= 1)"
+    )
     return [
-        ("sincos: π/2 = P1 + P2 + P3 + P3T and 2/π re-derived from π equal fdlibm's bits",
-         all(REDUCTION[k] == _from_bits(b) for k, b in _FDLIBM_REDUCTION.items())),
-        ("sincos: P1, P2, P3 have <= 33 significant bits (fn·P exact for |fn| <= 2^20)",
-         all(math.frexp(REDUCTION[k])[0] * 2**33 % 1 == 0 for k in ("P1", "P2", "P3"))),
-        (f"sincos: polynomial relative errors on [0, π/4] (sin {poly_s:.1e}, cos {poly_c:.1e}) < 2^-57",
-         max(poly_s, poly_c) < 2.0**-57),
+        (
+            "sincos: π/2 = P1 + P2 + P3 + P3T and 2/π re-derived from π equal fdlibm's bits",
+            all(REDUCTION[k] == _from_bits(b) for k, b in _FDLIBM_REDUCTION.items()),
+        ),
+        (
+            "sincos: P1, P2, P3 have <= 33 significant bits (fn·P exact for |fn| <= 2^20)",
+            all(math.frexp(REDUCTION[k])[0] * 2**33 % 1 == 0 for k in ("P1", "P2", "P3")),
+        ),
+        (
+            f"sincos: polynomial relative errors on [0, π/4] (sin {poly_s:.1e}, cos {poly_c:.1e}) < 2^-57",
+            max(poly_s, poly_c) < 2.0**-57,
+        ),
         (ulp_claim, max(err_s, err_c) <= 1.0),
         ("sincos: (±0) -> (±0, 1), ±inf and NaN -> NaN", _special_values_hold(sincos)),
     ]

@@ -45,8 +45,9 @@ def _generated(name: str):
 
 
 crash3, delta_v, inverse, particle, planar, presets, reconstruct, report = (
-    _generated(name) for name in ("crash3", "delta_v", "inverse", "particle", "planar",
-                                  "presets", "reconstruct", "report"))
+    _generated(name)
+    for name in ("crash3", "delta_v", "inverse", "particle", "planar", "presets", "reconstruct", "report")
+)
 CODES = _generated("codes")
 PRESETS = presets.PRESETS
 COEFFICIENT_INPUTS = presets.COEFFICIENT_INPUTS
@@ -58,8 +59,25 @@ FLAG_PDOF_CAPPED = CODES.FLAG_PDOF_CAPPED
 
 SERIAL_BELOW = 64
 
-OUTPUTS = ("V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M",
-           "mu", "mu_c", "dV1", "dV2", "TL", "TLn", "TLt", "TLm")
+OUTPUTS = (
+    "V1x",
+    "V1y",
+    "W1",
+    "V2x",
+    "V2y",
+    "W2",
+    "Pn",
+    "Pt",
+    "M",
+    "mu",
+    "mu_c",
+    "dV1",
+    "dV2",
+    "TL",
+    "TLn",
+    "TLt",
+    "TLm",
+)
 
 
 # Output tiers of solve_batch(outputs=...): each adds to the one before.
@@ -77,14 +95,18 @@ def requested_outputs(outputs) -> tuple[tuple[str, ...], str]:
         return OUTPUTS, "energy"
     if isinstance(outputs, str):
         if outputs not in TIERS:
-            raise ValueError(f"outputs: unknown tier {outputs!r} (use one of "
-                             f"{', '.join(TIERS)}, all, or a list of output names)")
+            raise ValueError(
+                f"outputs: unknown tier {outputs!r} (use one of "
+                f"{', '.join(TIERS)}, all, or a list of output names)"
+            )
         return TIERS[outputs], outputs
     names = tuple(outputs)
     unknown = [name for name in names if name not in OUTPUTS]
     if unknown or not names:
-        raise ValueError(f"outputs: unknown output {', '.join(unknown) or '(none given)'} "
-                         f"(outputs are {' '.join(OUTPUTS)})")
+        raise ValueError(
+            f"outputs: unknown output {', '.join(unknown) or '(none given)'} "
+            f"(outputs are {' '.join(OUTPUTS)})"
+        )
     tier = next(t for t, have in TIERS.items() if set(names) <= set(have))
     return names, tier
 
@@ -187,8 +209,12 @@ def _kernel_set(module, name: str) -> KernelSet:
 
 def _forward_name(family: str, critical: bool, no_moment: bool, tier: str) -> str:
     """Generated kernel name: rigid[_critical][_em1][_velocities|_impulses]."""
-    return (family + ("_critical" if critical else "") + ("_em1" if no_moment else "")
-            + ("" if tier == "energy" else f"_{tier}"))
+    return (
+        family
+        + ("_critical" if critical else "")
+        + ("_em1" if no_moment else "")
+        + ("" if tier == "energy" else f"_{tier}")
+    )
 
 
 def _forward_kernels() -> dict:
@@ -214,8 +240,7 @@ INVERSE = {
 }
 RECONSTRUCT = _kernel_set(reconstruct, "reconstruct")
 
-INVERSE_OUTPUTS = ("v1x", "v1y", "w1", "v2x", "v2y", "w2", "Pn", "Pt", "M",
-                   "mu_c", "TL", "TLn", "TLt", "TLm")
+INVERSE_OUTPUTS = ("v1x", "v1y", "w1", "v2x", "v2y", "w2", "Pn", "Pt", "M", "mu_c", "TL", "TLn", "TLt", "TLm")
 
 # Kernel families; the model names a scene may give, and the family each
 # selects with its fixed coefficients, are generated.presets.PRESETS.
@@ -234,9 +259,20 @@ KINETIC_ENERGY = _kernel_set(report, "kinetic_energy")
 # outputs plus d_<output>__d_<input> (angles in radians, inputs as the batch
 # columns, gamma rather than the normal's components).
 JACOBIAN_KERNELS = (
-    "rigid", "rigid_critical", "particle", "particle_critical", "rigid_inverse",
-    "particle_inverse", "reconstruct", "crash3_energy_2", "crash3_energy_4", "crash3_energy_6",
-    "crash3_delta_v", "crash3_moment_arm", "crash3_radius_of_gyration")
+    "rigid",
+    "rigid_critical",
+    "particle",
+    "particle_critical",
+    "rigid_inverse",
+    "particle_inverse",
+    "reconstruct",
+    "crash3_energy_2",
+    "crash3_energy_4",
+    "crash3_energy_6",
+    "crash3_delta_v",
+    "crash3_moment_arm",
+    "crash3_radius_of_gyration",
+)
 _LAZY: dict = {}
 
 
@@ -266,8 +302,7 @@ def preset(model: str) -> tuple[str, dict]:
     return row["kernel"], {COEFFICIENT_INPUTS[k]: v for k, v in row["fixed"].items()}
 
 
-def kernel_for(model: str, critical: bool, no_moment: bool = False,
-               tier: str = "energy") -> KernelSet:
+def kernel_for(model: str, critical: bool, no_moment: bool = False, tier: str = "energy") -> KernelSet:
     """The forward kernel of a kernel family for an impulse-ratio mode, e_m = 1
     (rigid only: no moment impulse) and an output tier; a family without a
     specialised kernel gets its full one. ValueError if the family is unknown."""
@@ -303,12 +338,12 @@ def _columns_for(ks: KernelSet, inputs: list, n: int) -> tuple[list, bool]:
     at = ks.inputs.index(ks.angle)
     angle = inputs[at]
     if not isinstance(angle, np.ndarray):
-        return inputs[:at] + list(ks.unit_normal(angle)) + inputs[at + 1:], True
+        return inputs[:at] + list(ks.unit_normal(angle)) + inputs[at + 1 :], True
     limit = _generated(ks.model).SINCOS_LIMIT
     if np.any(np.isfinite(angle) & (np.abs(angle) > limit)):
         with np.errstate(invalid="ignore"):
             normal = [np.cos(angle), np.sin(angle)]
-        return inputs[:at] + normal + inputs[at + 1:], True
+        return inputs[:at] + normal + inputs[at + 1 :], True
     return inputs, False
 
 
@@ -318,8 +353,7 @@ def _compile_notice(ks: KernelSet, driver, parallel: bool):
     if driver.signatures or math.isinf(COMPILE_NOTICE_AFTER):
         return None
     seconds = max(2, round(ks.operations / (20 if parallel else 35)))
-    message = (f"impactsym: compiling the {ks.name} batch kernel for this machine "
-               f"(once; about {seconds} s)")
+    message = f"impactsym: compiling the {ks.name} batch kernel for this machine (once; about {seconds} s)"
     timer = threading.Timer(COMPILE_NOTICE_AFTER, print, (message,), {"file": sys.stderr})
     timer.daemon = True
     timer.start()
@@ -341,8 +375,7 @@ def _call(ks: KernelSet, driver, parallel: bool, columns: list, outs: list) -> N
         fills = [None if isinstance(c, np.ndarray) else np.full(size, c) for c in columns]
         for start in range(0, n, size):
             stop = min(start + size, n)
-            args = [c[start:stop] if f is None else f[:stop - start]
-                    for c, f in zip(columns, fills)]
+            args = [c[start:stop] if f is None else f[: stop - start] for c, f in zip(columns, fills)]
             driver(*args, *(o[start:stop] for o in outs))
     finally:
         if timer is not None:
@@ -374,12 +407,22 @@ def batch_drivers():
     """(kernel, parallel, normal) for every numba driver the runtime calls
     (the Jacobian drivers are not among them: uncertainty evaluates the
     Jacobian at one scene, with the per-scene function)."""
-    sets = [*KERNELS.values(), DELTA_V, *INVERSE.values(), RECONSTRUCT, *CRASH3_ENERGY.values(),
-            CRASH3_DELTA_V, CRASH3_DELTA_V_ABSORBED, CRASH3_MOMENT_ARM,
-            CRASH3_RADIUS_OF_GYRATION, CRASH3_IMPLIED_PDOF, KINETIC_ENERGY]
+    sets = [
+        *KERNELS.values(),
+        DELTA_V,
+        *INVERSE.values(),
+        RECONSTRUCT,
+        *CRASH3_ENERGY.values(),
+        CRASH3_DELTA_V,
+        CRASH3_DELTA_V_ABSORBED,
+        CRASH3_MOMENT_ARM,
+        CRASH3_RADIUS_OF_GYRATION,
+        CRASH3_IMPLIED_PDOF,
+        KINETIC_ENERGY,
+    ]
     for ks in sets:
         for parallel in (True, False):
-            for normal in ((False, True) if ks.angle else (False,)):
+            for normal in (False, True) if ks.angle else (False,):
                 yield ks, parallel, normal
 
 
@@ -433,7 +476,7 @@ def run_one(ks: KernelSet, values: dict, outputs: tuple[str, ...]) -> dict:
     args = [float(values[name]) for name in ks.inputs]
     if ks.arguments is not None:
         at = ks.inputs.index(ks.angle)
-        args[at:at + 1] = ks.unit_normal(args[at])
+        args[at : at + 1] = ks.unit_normal(args[at])
     *outs, status, flags = ks.scene(*args)
     result = dict(zip(ks.outputs, outs))
     for name in outputs:

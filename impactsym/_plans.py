@@ -22,14 +22,21 @@ from ._util import require
 from .batch import solve_batch
 from .scene import CRITICAL, load_scene, show_value
 
-__all__ = ["GridPlan", "SamplePlan", "frame_of", "check_outputs", "is_integer",
-           "ALIASES", "BLOCK", "DISTRIBUTIONS"]
+__all__ = [
+    "GridPlan",
+    "SamplePlan",
+    "frame_of",
+    "check_outputs",
+    "is_integer",
+    "ALIASES",
+    "BLOCK",
+    "DISTRIBUTIONS",
+]
 
 #: Rows per random block of `sample`: block b is drawn from its own stream.
 BLOCK = 1 << 16
 #: Scene-file names accepted in place of kernel inputs.
-ALIASES = {"normal_angle": "gamma", "restitution": "e", "impulse_ratio": "mu",
-           "moment_restitution": "e_m"}
+ALIASES = {"normal_angle": "gamma", "restitution": "e", "impulse_ratio": "mu", "moment_restitution": "e_m"}
 #: Distributions of `sample`: kind -> names of its parameters.
 DISTRIBUTIONS = {
     "uniform": ("low", "high"),
@@ -40,6 +47,7 @@ DISTRIBUTIONS = {
 
 
 # --------------------------------------------------------------------------- names and values
+
 
 @dataclass(frozen=True)
 class _Base:
@@ -111,8 +119,10 @@ def _grid_values(name: str, kernel: str, raw):
     if isinstance(items, np.ndarray):
         return items.astype(np.float64)
     if critical_ok and any(isinstance(v, str) and v == CRITICAL for v in items):
-        return np.array([v if isinstance(v, str) and v == CRITICAL else _float(name, v, expected)
-                         for v in items], dtype=object)
+        return np.array(
+            [v if isinstance(v, str) and v == CRITICAL else _float(name, v, expected) for v in items],
+            dtype=object,
+        )
     return np.array([_float(name, v, expected) for v in items], dtype=np.float64)
 
 
@@ -129,6 +139,7 @@ def check_outputs(outputs) -> tuple[str, ...]:
 
 
 # --------------------------------------------------------------------------- plans: what a chunk computes
+
 
 def _solved_frame(plan, shown: dict, varied: dict, start: int, stop: int):
     """Solve rows start..stop-1: ``varied`` kernel inputs (arrays) over the
@@ -180,8 +191,9 @@ class GridPlan(_Plan):
             varied.append(kernel)
             shown.append(given)
             axes.append(_to_kernel_units(name, given))
-        return cls(base.model, base.units, outputs, constants, tuple(names), tuple(varied),
-                   tuple(shown), tuple(axes))
+        return cls(
+            base.model, base.units, outputs, constants, tuple(names), tuple(varied), tuple(shown), tuple(axes)
+        )
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -208,8 +220,11 @@ class GridPlan(_Plan):
         (coordinates as given), one variable per output, ``status``, ``flags``."""
         import xarray
 
-        data = {name: (self.names, frame[name].to_numpy().reshape(self.shape))
-                for name in frame.columns if name not in self.names}
+        data = {
+            name: (self.names, frame[name].to_numpy().reshape(self.shape))
+            for name in frame.columns
+            if name not in self.names
+        }
         coords = dict(zip(self.names, self.shown))
         return xarray.Dataset(data, coords=coords, attrs={"model": self.model, "units": self.units})
 
@@ -239,8 +254,9 @@ class SamplePlan(_Plan):
         checked = tuple(_distribution(name, dists[name]) for name in dists)
         constants = {k: v for k, v in base.constants.items() if k not in kernels}
         entropy = np.random.SeedSequence(seed).entropy
-        return cls(base.model, base.units, outputs, constants, tuple(dists), kernels, checked,
-                   entropy, int(n))
+        return cls(
+            base.model, base.units, outputs, constants, tuple(dists), kernels, checked, entropy, int(n)
+        )
 
     repeated = ()  # drawn columns hardly ever repeat a value
 
@@ -263,8 +279,10 @@ class SamplePlan(_Plan):
         """Rows start..stop-1 drawn and solved, as a DataFrame indexed start..stop-1."""
         drawn = self.draws(start, stop)
         shown = dict(zip(self.names, drawn))
-        varied = {kernel: _to_kernel_units(name, column)
-                  for name, kernel, column in zip(self.names, self.kernels, drawn)}
+        varied = {
+            kernel: _to_kernel_units(name, column)
+            for name, kernel, column in zip(self.names, self.kernels, drawn)
+        }
         return _solved_frame(self, shown, varied, start, stop)
 
 
@@ -276,15 +294,18 @@ def _distribution(name: str, spec) -> tuple[str, tuple[float, ...]]:
     """``(kind, parameters)`` of a distribution, checked; ValueError naming ``name``."""
     kinds = ", ".join(DISTRIBUTIONS)
     if not isinstance(spec, (tuple, list)) or not spec or not isinstance(spec[0], str):
-        raise ValueError(f"{name}: expected a tuple (kind, parameters...) with kind one of {kinds}, "
-                         f"got {show_value(spec)}")
+        raise ValueError(
+            f"{name}: expected a tuple (kind, parameters...) with kind one of {kinds}, got {show_value(spec)}"
+        )
     kind, params = spec[0], spec[1:]
     if kind not in DISTRIBUTIONS:
         raise ValueError(f"{name}: unknown distribution {kind!r} (use one of {kinds})")
     wanted = DISTRIBUTIONS[kind]
     if len(params) != len(wanted) or not all(_is_number(p) and math.isfinite(p) for p in params):
-        raise ValueError(f"{name}: {kind} takes {len(wanted)} finite numbers ({', '.join(wanted)}), "
-                         f"got {show_value(tuple(params))}")
+        raise ValueError(
+            f"{name}: {kind} takes {len(wanted)} finite numbers ({', '.join(wanted)}), "
+            f"got {show_value(tuple(params))}"
+        )
     params = tuple(float(p) for p in params)
     problem = _distribution_problem(kind, params)
     if problem:

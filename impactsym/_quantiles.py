@@ -36,9 +36,13 @@ def counts(status: np.ndarray, flags: np.ndarray) -> dict:
     `impactsym.codes.describe_status`)."""
     solved = int(np.count_nonzero(status == 0))
     codes, numbers = np.unique(status[status != 0], return_counts=True)
-    return {"rows": int(status.size), "solved": solved, "not_solved": int(status.size) - solved,
-            "flagged": int(np.count_nonzero(flags)),
-            "not_solved_by_status": {int(c): int(k) for c, k in zip(codes, numbers)}}
+    return {
+        "rows": int(status.size),
+        "solved": solved,
+        "not_solved": int(status.size) - solved,
+        "flagged": int(np.count_nonzero(flags)),
+        "not_solved_by_status": {int(c): int(k) for c, k in zip(codes, numbers)},
+    }
 
 
 def add_counts(total: dict, more: dict) -> None:
@@ -61,10 +65,14 @@ def summary_frame(pd, stats: Mapping, q: tuple[float, ...], counts: dict):
     """The summary DataFrame: one row per column, one column per percentile."""
     labels = [_label(v) for v in q]
     rows = {name: _interpolate(stat, q) for name, stat in stats.items()}
-    frame = (pd.DataFrame.from_dict(rows, orient="index", columns=labels) if rows
-             else pd.DataFrame(columns=labels, dtype=np.float64))
-    frame.attrs["counts"] = {key: dict(value) if isinstance(value, dict) else value
-                             for key, value in counts.items()}
+    frame = (
+        pd.DataFrame.from_dict(rows, orient="index", columns=labels)
+        if rows
+        else pd.DataFrame(columns=labels, dtype=np.float64)
+    )
+    frame.attrs["counts"] = {
+        key: dict(value) if isinstance(value, dict) else value for key, value in counts.items()
+    }
     return frame
 
 
@@ -105,8 +113,7 @@ class StreamSummary:
     files in ``directory``."""
 
     def __init__(self, columns: list[str], directory: Path):
-        self.counts = {"rows": 0, "solved": 0, "not_solved": 0, "flagged": 0,
-                       "not_solved_by_status": {}}
+        self.counts = {"rows": 0, "solved": 0, "not_solved": 0, "flagged": 0, "not_solved_by_status": {}}
         self.stats = {name: OrderStatistics(directory / f"{i}.f8") for i, name in enumerate(columns)}
 
     def add(self, frame) -> None:

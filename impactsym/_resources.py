@@ -20,8 +20,7 @@ import shutil
 import tempfile
 from pathlib import Path
 
-__all__ = ["DISK_FRACTION", "MEMORY_FRACTION", "available_memory", "check_disk", "check_memory",
-           "size"]
+__all__ = ["DISK_FRACTION", "MEMORY_FRACTION", "available_memory", "check_disk", "check_memory", "size"]
 
 #: The largest share of the available memory an in-memory result may take.
 MEMORY_FRACTION = 0.5
@@ -72,7 +71,8 @@ def check_memory(rows: int, values_per_row: int, what: str) -> None:
         raise ValueError(
             f"{what}: {rows:,} rows need about {size(need)} in memory, more than half of the "
             f"{size(available)} available; write the rows to a file chunk by chunk (-o "
-            "rows.parquet; out= in the API), or use fewer points")
+            "rows.parquet; out= in the API), or use fewer points"
+        )
 
 
 def check_disk(rows: int, values_per_row: int, what: str) -> None:
@@ -86,4 +86,5 @@ def check_disk(rows: int, values_per_row: int, what: str) -> None:
         raise ValueError(
             f"{what}: {rows:,} rows need about {size(need)} of temporary space for exact "
             f"percentiles in {folder}, which has {size(free)} free; use fewer points (or "
-            "point TMPDIR at a larger disk)")
+            "point TMPDIR at a larger disk)"
+        )

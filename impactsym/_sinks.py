@@ -105,8 +105,7 @@ def sink(out, repeated: tuple[str, ...] = ()):
         return _ParquetSink(path, ("status", "flags", *repeated))
     if suffix == ".csv":
         return _CsvSink(path)
-    raise ValueError(f"out: unknown file type {suffix or '(none)'!r} for {path} "
-                     f"(use {' or '.join(SINKS)})")
+    raise ValueError(f"out: unknown file type {suffix or '(none)'!r} for {path} (use {' or '.join(SINKS)})")
 
 
 def write_frame(frame, out, repeated: tuple[str, ...] = ()) -> None:

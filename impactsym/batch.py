@@ -35,12 +35,18 @@ from .dask_engine import map_chunks
 from .scene import CRITICAL
 
 #: Scene-file words for batch columns: a near miss of one suggests its column.
-_SCENE_WORDS = {"restitution": "e", "impulse_ratio": "mu", "moment_restitution": "e_m",
-                "normal_angle": "gamma", "mass": "m1", "yaw_inertia": "I1", "yaw_rate": "w1"}
+_SCENE_WORDS = {
+    "restitution": "e",
+    "impulse_ratio": "mu",
+    "moment_restitution": "e_m",
+    "normal_angle": "gamma",
+    "mass": "m1",
+    "yaw_inertia": "I1",
+    "yaw_rate": "w1",
+}
 
 
-def check_columns(columns, known: tuple[str, ...], model: str,
-                  everywhere: tuple[str, ...] = ()) -> None:
+def check_columns(columns, known: tuple[str, ...], model: str, everywhere: tuple[str, ...] = ()) -> None:
     """ValueError unless ``columns`` is a mapping (or DataFrame) of columns
     that the kernel reads (``known``): a name in ``everywhere`` (read by other
     models) is "given but not used by ``model``" (``"the particle model"``), any other is unknown, with
@@ -50,8 +56,7 @@ def check_columns(columns, known: tuple[str, ...], model: str,
         if name in known:
             continue
         if name in everywhere:
-            raise ValueError(f"{name}: given but not used by {model} "
-                             f"(its columns: {' '.join(known)})")
+            raise ValueError(f"{name}: given but not used by {model} (its columns: {' '.join(known)})")
         raise ValueError(f"{name}: {unknown_key(str(name), known, 'column', _SCENE_WORDS)}")
 
 
@@ -64,13 +69,16 @@ def require_mapping(columns) -> None:
 def _not_a_mapping(columns) -> str:
     """Why ``columns`` is not a batch, and what to pass instead."""
     if isinstance(columns, np.ndarray) and columns.dtype.names:
-        return ("columns: a structured array; pass a dict of its fields, "
-                "{name: a[name] for name in a.dtype.names}, or a pandas DataFrame")
+        return (
+            "columns: a structured array; pass a dict of its fields, "
+            "{name: a[name] for name in a.dtype.names}, or a pandas DataFrame"
+        )
     if isinstance(columns, (list, tuple)):
-        return ("columns: a list (one scene per item?); pass a dict of columns "
-                "(name -> array) or pandas.DataFrame(rows)")
-    return ("columns: must be a dict of columns (name -> array) or a DataFrame, "
-            f"got {type(columns).__name__}")
+        return (
+            "columns: a list (one scene per item?); pass a dict of columns "
+            "(name -> array) or pandas.DataFrame(rows)"
+        )
+    return f"columns: must be a dict of columns (name -> array) or a DataFrame, got {type(columns).__name__}"
 
 
 _ALL_NUMBERS = object()  # no bad element found (None itself is a bad one)
@@ -82,21 +90,26 @@ def _check_numbers(arr: np.ndarray, name: str) -> None:
     read True as 1.0 and "0.3" as 0.3)."""
     kind = arr.dtype.kind
     if arr.dtype.names:
-        raise ValueError(f"{name}: a structured array, not a numeric column "
-                         f"(fields {', '.join(arr.dtype.names)}; pass one field)")
+        raise ValueError(
+            f"{name}: a structured array, not a numeric column "
+            f"(fields {', '.join(arr.dtype.names)}; pass one field)"
+        )
     if kind in "fiu":
         return
     if kind == "O":
-        not_numbers = (v for v in arr.flat
-                       if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real))
+        not_numbers = (
+            v for v in arr.flat if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real)
+        )
         bad = next(not_numbers, _ALL_NUMBERS)
         if bad is _ALL_NUMBERS:
             return
         shown = repr(bad) if len(repr(bad)) <= 40 else repr(bad)[:37] + "..."
         raise ValueError(f"{name}: must be numbers, got {shown} ({type(bad).__name__})")
     what = {"b": "true/false (bool)", "U": "text", "S": "bytes"}.get(kind, f"dtype {arr.dtype}")
-    raise ValueError(f"{name}: must be numbers, got {what}; a batch, like a scene file, "
-                     "reads numbers only (no units, no booleans)")
+    raise ValueError(
+        f"{name}: must be numbers, got {what}; a batch, like a scene file, "
+        "reads numbers only (no units, no booleans)"
+    )
 
 
 def _as_column(columns, name: str):
@@ -117,8 +130,7 @@ def _as_column(columns, name: str):
     return arr
 
 
-def run_columns(ks: _kernels.KernelSet, columns, outputs, model: str,
-                everywhere: tuple[str, ...] = ()):
+def run_columns(ks: _kernels.KernelSet, columns, outputs, model: str, everywhere: tuple[str, ...] = ()):
     """Validate `columns` for kernel `ks` (`check_columns`: `model` names it
     in messages, ``"the particle model"``; `everywhere` are the columns of
     its other models), run it,
@@ -132,8 +144,7 @@ def _run(ks: _kernels.KernelSet, columns, outputs, placeholders) -> dict:
     """Validate `columns` for kernel `ks`, run it, collect `outputs` (a dict)."""
     names = [k for k in ks.inputs if k not in placeholders]
     n = row_count(columns, names)
-    inputs = [0.0 if name in placeholders else _as_column(columns, name)
-              for name in ks.inputs]
+    inputs = [0.0 if name in placeholders else _as_column(columns, name) for name in ks.inputs]
     outs, status, flags = _kernels.run_batch(ks, inputs, n)
     if "e" in names:
         _flag_restitution(inputs[ks.inputs.index("e")], status, flags)
@@ -157,8 +168,10 @@ def _collect(ks, outs, status, flags, outputs, n) -> dict:
     NaN on rows that were not solved."""
     failed = status != 0
     failed = failed if failed.any() else None
-    result = {name: outs[name] if name in outs else _filler(failed, n, ks.constants.get(name, 0.0))
-              for name in outputs}
+    result = {
+        name: outs[name] if name in outs else _filler(failed, n, ks.constants.get(name, 0.0))
+        for name in outputs
+    }
     result["status"], result["flags"] = status, flags
     return result
 
@@ -229,11 +242,9 @@ def solve_batch_dask(columns, model="rigid", outputs=None, chunk_size: int = CHU
     per row) and the same result (a dict, or a DataFrame with the input's
     index) as the local engine. Each chunk is sent to the cluster ahead of
     its task, not embedded in the task graph."""
-    data = {name: columns[name].to_numpy() if is_dataframe(columns) else columns[name]
-            for name in columns}
+    data = {name: columns[name].to_numpy() if is_dataframe(columns) else columns[name] for name in columns}
     n = row_count({**data, "model": model})
-    chunks = ((_rows(data, *span), _rows({"model": model}, *span)["model"])
-              for span in spans(n, chunk_size))
+    chunks = ((_rows(data, *span), _rows({"model": model}, *span)["model"]) for span in spans(n, chunk_size))
     parts = list(map_chunks(_solve_chunk, outputs, chunks, scatter_items=True))
     return _like(columns, {name: np.concatenate([part[name] for part in parts]) for name in parts[0]})
 
@@ -246,8 +257,7 @@ def _solve_chunk(outputs, chunk: tuple) -> dict:
 
 def _rows(columns: dict, start: int, stop: int) -> dict:
     """Rows start..stop-1 of every array column; scalars stay scalars."""
-    return {name: column if np.ndim(column) == 0 else column[start:stop]
-            for name, column in columns.items()}
+    return {name: column if np.ndim(column) == 0 else column[start:stop] for name, column in columns.items()}
 
 
 def _forward_inputs(model: str) -> tuple[str, ...]:
@@ -354,16 +364,21 @@ def _with_fixed(columns, fixed: dict, model: str, mixed: bool) -> dict:
         if name not in columns:
             continue
         if not mixed or not _matches(columns[name], value):
-            raise ValueError(f"{name}: the {model} model fixes {name} = {value}; "
-                             "leave the column out" + (" or give that value or NaN" if mixed else ""))
+            raise ValueError(
+                f"{name}: the {model} model fixes {name} = {value}; "
+                "leave the column out" + (" or give that value or NaN" if mixed else "")
+            )
     return {**{name: columns[name] for name in columns}, **fixed}
 
 
 def _matches(column, value) -> bool:
     """Every entry of the column is `value` or NaN ("critical" for μ = μ_c)."""
     if isinstance(value, str):
-        return isinstance(column, str) and column == value or (
-            np.ndim(column) > 0 and bool(np.all(np.isnan(np.asarray(column, dtype=float)))))
+        return (
+            isinstance(column, str)
+            and column == value
+            or (np.ndim(column) > 0 and bool(np.all(np.isnan(np.asarray(column, dtype=float)))))
+        )
     arr = np.asarray(column, dtype=float)
     return bool(np.all((arr == value) | np.isnan(arr)))
 

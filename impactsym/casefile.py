@@ -60,38 +60,77 @@ __all__ = [
 ]
 
 COEFFICIENT_KEYS = ("restitution", "impulse_ratio", "moment_restitution", "slip")
-TOP_KEYS = ("model", "units", "impact", "vehicles", "title", "description", "notes", "comment",
-            "correlations", "crash3", "impact_position")
+TOP_KEYS = (
+    "model",
+    "units",
+    "impact",
+    "vehicles",
+    "title",
+    "description",
+    "notes",
+    "comment",
+    "correlations",
+    "crash3",
+    "impact_position",
+)
 IMPACT_KEYS = ("normal_angle", *COEFFICIENT_KEYS, "position")
-VEHICLE_KEYS = ("name", "fixed", "mass", "weight", "yaw_inertia", "radius_of_gyration",
-                "velocity", "yaw_rate", "impact_point", "heading", "final_velocity",
-                "final_yaw_rate", "crush", "length", "width")
+VEHICLE_KEYS = (
+    "name",
+    "fixed",
+    "mass",
+    "weight",
+    "yaw_inertia",
+    "radius_of_gyration",
+    "velocity",
+    "yaw_rate",
+    "impact_point",
+    "heading",
+    "final_velocity",
+    "final_yaw_rate",
+    "crush",
+    "length",
+    "width",
+)
 POLAR_KEYS = ("speed", "direction")
 VEHICLE_FRAME_KEYS = ("forward", "left")
 VEHICLE_POLAR_KEYS = ("distance", "angle")
-_FORM_DIMENSIONS = {"speed": "speed", "direction": "angle", "forward": "length", "left": "length",
-                    "distance": "length", "angle": "angle"}
+_FORM_DIMENSIONS = {
+    "speed": "speed",
+    "direction": "angle",
+    "forward": "length",
+    "left": "length",
+    "distance": "length",
+    "angle": "angle",
+}
 
 
 def _forms(kind: str) -> tuple[tuple[str, ...], ...]:
     """The table forms of a vector field besides [x, y]."""
-    return {"velocity": (POLAR_KEYS,), "impact_point": (VEHICLE_FRAME_KEYS, VEHICLE_POLAR_KEYS),
-            "": ()}[kind]
+    return {"velocity": (POLAR_KEYS,), "impact_point": (VEHICLE_FRAME_KEYS, VEHICLE_POLAR_KEYS), "": ()}[kind]
+
+
 #: Distribution kinds and their parameters (in the field's units).
-DISTRIBUTIONS = {"normal": ("mean", "sd"), "uniform": ("low", "high"),
-                 "triangular": ("low", "mode", "high")}
+DISTRIBUTIONS = {"normal": ("mean", "sd"), "uniform": ("low", "high"), "triangular": ("low", "mode", "high")}
 #: Numeric entries of a ``crush`` table and their dimensions (units.DIMENSIONS);
 #: its other entries are CRASH3's to check (impactsym.crash3).
-CRUSH_LEAVES = {"A": "stiffness_A", "B": "stiffness_B", "width": "crush_length",
-                "pdof": "angle", "moment_arm": "length", "radius_of_gyration": "length"}
+CRUSH_LEAVES = {
+    "A": "stiffness_A",
+    "B": "stiffness_B",
+    "width": "crush_length",
+    "pdof": "angle",
+    "moment_arm": "length",
+    "radius_of_gyration": "length",
+}
 #: The domain of a leaf: what its nominal value and every draw must satisfy.
 #: The largest |angle| a leaf may give, in degrees. An angle is read modulo
 #: 360, but one beyond a million degrees is a slip of the keyboard (1e300 for
 #: 100), not a direction: it is refused rather than reduced.
 MAX_ANGLE_DEG = 1e6
-DOMAINS = {"any": ("", lambda x: np.isfinite(x)),
-           "positive": ("positive ", lambda x: x > 0.0),
-           "nonnegative": ("non-negative ", lambda x: x >= 0.0)}
+DOMAINS = {
+    "any": ("", lambda x: np.isfinite(x)),
+    "positive": ("positive ", lambda x: x > 0.0),
+    "nonnegative": ("non-negative ", lambda x: x >= 0.0),
+}
 
 
 def check_keys(data: Mapping, known: tuple[str, ...], path: str) -> None:
@@ -102,8 +141,9 @@ def check_keys(data: Mapping, known: tuple[str, ...], path: str) -> None:
             raise SceneError(unknown_key(str(key), known), f"{path}.{key}" if path else str(key))
 
 
-def unknown_key(key: str, known: tuple[str, ...], word: str = "key",
-                aliases: Mapping[str, str] | None = None) -> str:
+def unknown_key(
+    key: str, known: tuple[str, ...], word: str = "key", aliases: Mapping[str, str] | None = None
+) -> str:
     """``unknown key; did you mean "restitution"?`` (difflib's nearest), or the list.
 
     ``word`` names what ``key`` is (``"column"`` for a batch). ``aliases`` maps
@@ -114,7 +154,7 @@ def unknown_key(key: str, known: tuple[str, ...], word: str = "key",
     close = difflib.get_close_matches(key, tuple(spellings), n=1, cutoff=0.6)
     if close:
         target = spellings[close[0]]
-        said = f' ({close[0]})' if target != close[0] else ""
+        said = f" ({close[0]})" if target != close[0] else ""
         return f'unknown {word}; did you mean "{target}"{said}?'
     return f"unknown {word} (known here: {', '.join(known)})"
 
@@ -195,22 +235,27 @@ class LeafReader:
             if math.isfinite(number):
                 return number
         word = DOMAINS[domain][0]
-        raise SceneError(f"must be a {word}finite number (or a number with a unit, or a "
-                         f"distribution), got {show_value(value)}", path)
+        raise SceneError(
+            f"must be a {word}finite number (or a number with a unit, or a "
+            f"distribution), got {show_value(value)}",
+            path,
+        )
 
     def _distribution(self, value: Mapping, path: str, dimension: str, domain: str) -> Leaf:
         """``{"normal": [mean, sd]}``, ``{"uniform": [low, high]}`` or
         ``{"triangular": [low, mode, high]}`` as a Leaf with its nominal value."""
         if len(value) != 1:
-            raise SceneError(f"a distribution has exactly one key ({', '.join(DISTRIBUTIONS)}), "
-                             f"got {show_value(dict(value))}", path)
-        (kind, raw), = value.items()
+            raise SceneError(
+                f"a distribution has exactly one key ({', '.join(DISTRIBUTIONS)}), "
+                f"got {show_value(dict(value))}",
+                path,
+            )
+        ((kind, raw),) = value.items()
         if kind not in DISTRIBUTIONS:
             raise SceneError(unknown_key(str(kind), tuple(DISTRIBUTIONS)), f"{path}.{kind}")
         names = DISTRIBUTIONS[kind]
         if not isinstance(raw, (list, tuple)) or len(raw) != len(names):
-            raise SceneError(f"must be a list [{', '.join(names)}], got {show_value(raw)}",
-                             f"{path}.{kind}")
+            raise SceneError(f"must be a list [{', '.join(names)}], got {show_value(raw)}", f"{path}.{kind}")
         params = tuple(self._plain(item, f"{path}.{kind}", dimension, "any") for item in raw)
         nominal = _check_distribution(kind, params, f"{path}.{kind}")
         return Leaf(path, dimension, domain, nominal, kind, params)
@@ -228,8 +273,7 @@ def _check_distribution(kind: str, params: tuple[float, ...], path: str) -> floa
         return 0.5 * (params[0] + params[1])
     low, mode, high = params
     if not (low <= mode <= high and low < high):
-        raise SceneError(f"needs low <= mode <= high and low < high, got "
-                         f"[{low:g}, {mode:g}, {high:g}]", path)
+        raise SceneError(f"needs low <= mode <= high and low < high, got [{low:g}, {mode:g}, {high:g}]", path)
     return mode
 
 
@@ -244,8 +288,11 @@ def _check_domain(nominal: float, raw: Any, path: str, domain: str) -> None:
 def _check_angle(degrees: float, path: str) -> None:
     """A SceneError for an angle beyond ±MAX_ANGLE_DEG degrees (scene units)."""
     if abs(degrees) > MAX_ANGLE_DEG:
-        raise SceneError(f"{degrees:g} degrees is not a usable angle: give it within [-360, 360] "
-                         f"(at most {MAX_ANGLE_DEG:g} degrees in magnitude)", path)
+        raise SceneError(
+            f"{degrees:g} degrees is not a usable angle: give it within [-360, 360] "
+            f"(at most {MAX_ANGLE_DEG:g} degrees in magnitude)",
+            path,
+        )
 
 
 def domain_reasons(leaves: Mapping[str, Leaf], values: Mapping[str, Any], n: int) -> np.ndarray:
@@ -267,6 +314,7 @@ def domain_reasons(leaves: Mapping[str, Leaf], values: Mapping[str, Any], n: int
 # --------------------------------------------------------------------------- alternative forms
 # Each function takes leaf values by path (floats or NumPy arrays) and returns
 # the scene-frame quantity; the same code serves the nominal scene and draws.
+
 
 def vehicle_state(values: Mapping[str, Any], index: int, units: str) -> dict[str, Any]:
     """Vehicle ``index`` in scene-frame quantities: ``m`` (None when not
@@ -381,8 +429,11 @@ def _check_uncertain_path(name: Any, leaves: Mapping[str, Leaf], where: str) -> 
     if not isinstance(name, str) or name not in leaves or leaves[name].kind is None:
         uncertain = tuple(p for p, leaf in leaves.items() if leaf.kind is not None)
         close = difflib.get_close_matches(str(name), uncertain, n=1, cutoff=0.6)
-        hint = f'; did you mean "{close[0]}"?' if close else \
-            f" (uncertain leaves: {', '.join(uncertain) or 'none'})"
+        hint = (
+            f'; did you mean "{close[0]}"?'
+            if close
+            else f" (uncertain leaves: {', '.join(uncertain) or 'none'})"
+        )
         raise SceneError(f"{show_value(name)} is not an uncertain leaf of the scene{hint}", where)
 
 
@@ -396,5 +447,7 @@ def _check_positive_semidefinite(pairs: list[tuple[str, str, float]]) -> None:
     for a, b, rho in pairs:
         matrix[index[a], index[b]] = matrix[index[b], index[a]] = rho
     if np.linalg.eigvalsh(matrix)[0] < -1e-12:
-        raise SceneError("the correlations do not form a valid correlation matrix (not positive "
-                         "semi-definite)", "correlations")
+        raise SceneError(
+            "the correlations do not form a valid correlation matrix (not positive semi-definite)",
+            "correlations",
+        )

@@ -140,26 +140,43 @@ def _add_crash3(parser: argparse.ArgumentParser) -> None:
     scene's ``"crash3"`` object. Values are checked by :func:`crash3` so that a
     bad one is the same one-line error as in a scene."""
     _add_scene(parser)
-    parser.add_argument("--restitution", type=float, default=None, metavar="E",
-                        help="restitution e (default: the scene's, else 0: CRASH3's common velocity)")
-    parser.add_argument("--energy", default=None, metavar="MODE",
-                        help="what the crush energy is: dissipated (over the impact, default) or "
-                             "absorbed (to maximum crush; total delta-V = (1 + e) x approach)")
-    parser.add_argument("--correction", default=None, metavar="NAME",
-                        help="oblique correction: crash3 (1 + tan^2 alpha, default) or woolley "
-                             "(1/cos alpha); both capped at 45 degrees as EDCRASH does")
+    parser.add_argument(
+        "--restitution",
+        type=float,
+        default=None,
+        metavar="E",
+        help="restitution e (default: the scene's, else 0: CRASH3's common velocity)",
+    )
+    parser.add_argument(
+        "--energy",
+        default=None,
+        metavar="MODE",
+        help="what the crush energy is: dissipated (over the impact, default) or "
+        "absorbed (to maximum crush; total delta-V = (1 + e) x approach)",
+    )
+    parser.add_argument(
+        "--correction",
+        default=None,
+        metavar="NAME",
+        help="oblique correction: crash3 (1 + tan^2 alpha, default) or woolley "
+        "(1/cos alpha); both capped at 45 degrees as EDCRASH does",
+    )
     add_plot_argument(parser)  # the CRASH3 diagram; with --uncertainty, histograms and budget
     uncertainty_cli.add_arguments(parser)
 
 
 def _run_crash3(args: argparse.Namespace) -> int:
     """CRASH3 delta-V from the vehicles' crush tables; print JSON or a table."""
-    result = crash3(args.scene, restitution=args.restitution, energy=args.energy,
-                    correction=args.correction)
+    result = crash3(args.scene, restitution=args.restitution, energy=args.energy, correction=args.correction)
     if args.uncertainty:
-        return uncertainty_cli.run(args, "crash3", result, restitution=result.restitution,
-                                   energy=result.options.energy,
-                                   correction=result.options.correction)
+        return uncertainty_cli.run(
+            args,
+            "crash3",
+            result,
+            restitution=result.restitution,
+            energy=result.options.energy,
+            correction=result.options.correction,
+        )
     if args.plot:
         save_plot(result, args.plot, scene=args.scene)
     return _print_result(result, args.json)
@@ -171,8 +188,9 @@ def _add_compare(parser: argparse.ArgumentParser) -> None:
     form = parser.add_mutually_exclusive_group()
     form.add_argument("--json", action="store_true", help="print the comparison as one JSON object")
     form.add_argument("--markdown", action="store_true", help="print the table as markdown")
-    parser.add_argument("--plot", metavar="OUT.png",
-                        help="also save a bar chart of delta-V and energy loss by model")
+    parser.add_argument(
+        "--plot", metavar="OUT.png", help="also save a bar chart of delta-V and energy loss by model"
+    )
 
 
 def _run_compare(args: argparse.Namespace) -> int:
@@ -197,30 +215,47 @@ _SUMMARY_LABELS = {"p0": "min", "p50": "median", "p100": "max"}
 
 def _add_run_options(parser: argparse.ArgumentParser) -> None:
     """Options shared by ``sweep`` and ``sample``: output file, tier, chunks, engine, progress."""
-    parser.add_argument("-o", "--out", metavar="OUT.parquet|OUT.csv",
-                        help="write every row to this file, chunk by chunk")
-    parser.add_argument("--outputs", choices=_OUTPUT_TIERS, default="all",
-                        help="outputs to compute (default all)")
-    parser.add_argument("--chunk-size", type=int, default=CHUNK_SIZE, metavar="N",
-                        help=f"rows per chunk (default {CHUNK_SIZE})")
-    parser.add_argument("--engine", choices=("local", "dask"), default="local",
-                        help="local, or dask: chunks as tasks on dask's scheduler (the dask extra)")
+    parser.add_argument(
+        "-o", "--out", metavar="OUT.parquet|OUT.csv", help="write every row to this file, chunk by chunk"
+    )
+    parser.add_argument(
+        "--outputs", choices=_OUTPUT_TIERS, default="all", help="outputs to compute (default all)"
+    )
+    parser.add_argument(
+        "--chunk-size",
+        type=int,
+        default=CHUNK_SIZE,
+        metavar="N",
+        help=f"rows per chunk (default {CHUNK_SIZE})",
+    )
+    parser.add_argument(
+        "--engine",
+        choices=("local", "dask"),
+        default="local",
+        help="local, or dask: chunks as tasks on dask's scheduler (the dask extra)",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
 
 
 def _add_sweep(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``sweep``: the scene, ``--vary`` (repeatable), run options, ``--plot``."""
     parser.add_argument("scene", help="base scene file (.json or .toml)")
-    parser.add_argument("--vary", action="append", default=[], metavar="NAME=VALUES",
-                        help="NAME=START:STOP:NUM (NUM values, both ends included), NAME=V1,V2,... "
-                             "(mu may list 'critical') or NAME=V (a constant); repeat for a grid, "
-                             "the first varying slowest. Names: kernel inputs (e, mu, e_m, gamma "
-                             "[rad], m1, v1x, ...) or normal_angle [deg], restitution, "
-                             "impulse_ratio, moment_restitution")
+    parser.add_argument(
+        "--vary",
+        action="append",
+        default=[],
+        metavar="NAME=VALUES",
+        help="NAME=START:STOP:NUM (NUM values, both ends included), NAME=V1,V2,... "
+        "(mu may list 'critical') or NAME=V (a constant); repeat for a grid, "
+        "the first varying slowest. Names: kernel inputs (e, mu, e_m, gamma "
+        "[rad], m1, v1x, ...) or normal_angle [deg], restitution, "
+        "impulse_ratio, moment_restitution",
+    )
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     _add_run_options(parser)
-    parser.add_argument("--plot", metavar="OUT.png",
-                        help="also draw the sweep (1 or 2 varied parameters; needs matplotlib)")
+    parser.add_argument(
+        "--plot", metavar="OUT.png", help="also draw the sweep (1 or 2 varied parameters; needs matplotlib)"
+    )
     parser.add_argument("--color", metavar="NAME", help="output drawn by --plot (default TL)")
 
 
@@ -268,8 +303,11 @@ def _named(pairs, option: str) -> dict:
 
 def _run_options(args: argparse.Namespace) -> dict:
     """Keyword arguments of the run: engine, chunk size, progress bar."""
-    return {"engine": args.engine, "chunk_size": args.chunk_size,
-            "progress": False if args.no_progress else None}
+    return {
+        "engine": args.engine,
+        "chunk_size": args.chunk_size,
+        "progress": False if args.no_progress else None,
+    }
 
 
 def _run_sweep(args: argparse.Namespace) -> int:
@@ -277,8 +315,10 @@ def _run_sweep(args: argparse.Namespace) -> int:
     values = _named((_parse_vary(text) for text in args.vary), "--vary")
     varied = [name for name, value in values.items() if np.ndim(value) == 1]
     if args.plot and not 1 <= len(varied) <= 2:
-        raise UsageError(f"--plot draws a sweep of 1 or 2 varied parameters, got {len(varied)}"
-                         + (f" ({', '.join(varied)})" if varied else ""))
+        raise UsageError(
+            f"--plot draws a sweep of 1 or 2 varied parameters, got {len(varied)}"
+            + (f" ({', '.join(varied)})" if varied else "")
+        )
     if args.color and not args.plot:
         raise UsageError("--color: only with --plot")
     if args.chunk_size < 1:
@@ -288,8 +328,7 @@ def _run_sweep(args: argparse.Namespace) -> int:
         if args.plot:
             summary = _sweep_and_plot(args, values, varied, plan.units)
         else:
-            summary = summarize(plan, out=args.out, q=SWEEP_PERCENTILES,
-                                       **_run_options(args))
+            summary = summarize(plan, out=args.out, q=SWEEP_PERCENTILES, **_run_options(args))
     if args.json:
         print(json.dumps(json_clean(_summary_json(summary, plan.units)), indent=2, allow_nan=False))
     else:
@@ -302,8 +341,14 @@ def _sweep_and_plot(args: argparse.Namespace, values: dict, varied: list, units:
     from .plot import save_sweep
 
     frame = solve_sweep(args.scene, outputs=args.outputs, **_run_options(args), **values)
-    save_sweep(frame, args.plot, x=varied[0], y=varied[1] if len(varied) == 2 else None,
-               color=args.color, units=units)
+    save_sweep(
+        frame,
+        args.plot,
+        x=varied[0],
+        y=varied[1] if len(varied) == 2 else None,
+        color=args.color,
+        units=units,
+    )
     if args.out:
         write_frame(frame, args.out, tuple(varied))
     return percentiles(frame, summary_columns(args.outputs), q=SWEEP_PERCENTILES)
@@ -312,10 +357,15 @@ def _sweep_and_plot(args: argparse.Namespace, values: dict, varied: list, units:
 def _add_sample(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``sample``: the scene, ``--dist`` (repeatable), ``-n``, ``--seed``, run options."""
     parser.add_argument("scene", help="base scene file (.json or .toml)")
-    parser.add_argument("--dist", action="append", default=[], metavar="NAME=KIND:P1:P2[:P3]",
-                        help="a drawn input: uniform:LOW:HIGH, normal:MEAN:SD, "
-                             "triangular:LEFT:MODE:RIGHT or lognormal:MEAN_OF_LOG:SD_OF_LOG "
-                             "(names as for sweep); repeat for more")
+    parser.add_argument(
+        "--dist",
+        action="append",
+        default=[],
+        metavar="NAME=KIND:P1:P2[:P3]",
+        help="a drawn input: uniform:LOW:HIGH, normal:MEAN:SD, "
+        "triangular:LEFT:MODE:RIGHT or lognormal:MEAN_OF_LOG:SD_OF_LOG "
+        "(names as for sweep); repeat for more",
+    )
     parser.add_argument("-n", type=int, required=True, metavar="N", help="number of scenes to draw")
     parser.add_argument("--seed", type=int, metavar="S", help="seed (default: fresh entropy, printed)")
     parser.add_argument("--json", action="store_true", help="print the summary as one JSON object")
@@ -341,8 +391,11 @@ def _run_sample(args: argparse.Namespace) -> int:
         plan = SamplePlan.build(args.scene, dists, args.n, args.seed, args.outputs)
         summary = summarize(plan, out=args.out, q=PERCENTILES, **_run_options(args))
     if args.json:
-        print(json.dumps(json_clean(_summary_json(summary, plan.units, plan.entropy)), indent=2,
-                         allow_nan=False))
+        print(
+            json.dumps(
+                json_clean(_summary_json(summary, plan.units, plan.entropy)), indent=2, allow_nan=False
+            )
+        )
     else:
         _print_summary(summary, plan.units, args.out, seed=plan.entropy)
     return 0
@@ -373,8 +426,10 @@ def _print_summary(summary, units: str, out, seed=None) -> None:
     counts = summary.attrs["counts"]
     if out:
         print(f"wrote {counts['rows']} rows to {out}")
-    print(f"rows {counts['rows']}: solved {counts['solved']}, flagged {counts['flagged']}, "
-          f"not solved {counts['not_solved']}" + (f"; seed {seed}" if seed is not None else ""))
+    print(
+        f"rows {counts['rows']}: solved {counts['solved']}, flagged {counts['flagged']}, "
+        f"not solved {counts['not_solved']}" + (f"; seed {seed}" if seed is not None else "")
+    )
     for status, rows in counts.get("not_solved_by_status", {}).items():
         print(f"  not solved, status {status}: {rows} rows: {describe_status(status)}")
     if counts["solved"] == 0 and counts["rows"]:
@@ -394,23 +449,33 @@ def _summary_json(summary, units: str, seed=None) -> dict:
     q values; ``not_solved_by_status`` maps status codes to row counts; a
     sample also gives its ``seed``)."""
     counts = dict(summary.attrs["counts"])
-    counts["not_solved_by_status"] = {str(code): rows for code, rows
-                                      in counts.get("not_solved_by_status", {}).items()}
+    counts["not_solved_by_status"] = {
+        str(code): rows for code, rows in counts.get("not_solved_by_status", {}).items()
+    }
     return {
         "units": units,
         **({"seed": seed} if seed is not None else {}),
         **counts,
-        "percentiles": {column: {label[1:]: json_number(float(value)) for label, value in row.items()}
-                        for column, row in summary.iterrows()},
+        "percentiles": {
+            column: {label[1:]: json_number(float(value)) for label, value in row.items()}
+            for column, row in summary.iterrows()
+        },
     }
 
 
 def _add_validate(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``validate``: ``--markdown`` and ``--plots DIR``."""
-    parser.add_argument("--markdown", action="store_true",
-                        help="print the whole report (statistics, per-row tables) as markdown")
-    parser.add_argument("--plots", metavar="DIR", default=None,
-                        help="save the predicted-versus-measured plots (PNG) in DIR (needs matplotlib)")
+    parser.add_argument(
+        "--markdown",
+        action="store_true",
+        help="print the whole report (statistics, per-row tables) as markdown",
+    )
+    parser.add_argument(
+        "--plots",
+        metavar="DIR",
+        default=None,
+        help="save the predicted-versus-measured plots (PNG) in DIR (needs matplotlib)",
+    )
 
 
 def _run_validate(args: argparse.Namespace) -> int:
@@ -442,8 +507,10 @@ def _run_compile(args: argparse.Namespace) -> int:
         raise
     warmup.finish(where, digest)
     if not args.quiet:
-        print(f"compiled or loaded {count} batch drivers in {time.perf_counter() - start:.0f} s; "
-              f"cache: {warmup.cache_dir(where)}")
+        print(
+            f"compiled or loaded {count} batch drivers in {time.perf_counter() - start:.0f} s; "
+            f"cache: {warmup.cache_dir(where)}"
+        )
     return 0
 
 

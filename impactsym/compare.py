@@ -42,9 +42,11 @@ from .single import solve
 __all__ = ["compare", "Comparison", "ModelRow", "COMPARED_MODELS"]
 
 COMPARED_MODELS = ("brach", "macmillan", "limpert", "impac", "impac_sideswipe", "particle", "crash3")
-CRASH3_ASSUMPTIONS = ("CRASH3 (McHenry): |delta-V| from the crush energy with a common velocity "
-                      "at the impact centre (e = 0, mu = mu_max); its direction from the entered "
-                      "PDOF; no yaw.")
+CRASH3_ASSUMPTIONS = (
+    "CRASH3 (McHenry): |delta-V| from the crush energy with a common velocity "
+    "at the impact centre (e = 0, mu = mu_max); its direction from the entered "
+    "PDOF; no yaw."
+)
 _ENERGY_PARTS = ("total", "normal", "tangential", "moment")
 
 
@@ -62,11 +64,14 @@ class VehicleRow:
 
     def to_json_dict(self) -> dict[str, Any]:
         """The vehicle entry of a model in ``compare --json``."""
-        return {"velocity": None if self.velocity is None else list(self.velocity),
-                "speed": self.speed, "direction": self.direction,
-                "yaw_rate": self.yaw_rate,
-                "delta_v": None if self.delta_v is None else list(self.delta_v),
-                "delta_v_magnitude": self.delta_v_magnitude}
+        return {
+            "velocity": None if self.velocity is None else list(self.velocity),
+            "speed": self.speed,
+            "direction": self.direction,
+            "yaw_rate": self.yaw_rate,
+            "delta_v": None if self.delta_v is None else list(self.delta_v),
+            "delta_v_magnitude": self.delta_v_magnitude,
+        }
 
 
 @dataclass(frozen=True)
@@ -86,11 +91,16 @@ class ModelRow:
 
     def to_json_dict(self) -> dict[str, Any]:
         """One model's entry in ``compare --json``."""
-        return {"model": self.model, "assumptions": self.assumptions,
-                "vehicles": [v.to_json_dict() for v in self.vehicles],
-                "energy_loss": dict(self.energy), "energy_loss_percent": dict(self.energy_percent),
-                "impulse_ratio": self.mu, "critical_impulse_ratio": self.mu_c,
-                "warnings": list(self.warnings)}
+        return {
+            "model": self.model,
+            "assumptions": self.assumptions,
+            "vehicles": [v.to_json_dict() for v in self.vehicles],
+            "energy_loss": dict(self.energy),
+            "energy_loss_percent": dict(self.energy_percent),
+            "impulse_ratio": self.mu,
+            "critical_impulse_ratio": self.mu_c,
+            "warnings": list(self.warnings),
+        }
 
 
 @dataclass(frozen=True)
@@ -107,10 +117,13 @@ class Comparison:
 
     def to_json_dict(self) -> dict[str, Any]:
         """The object printed by ``impactsym compare --json``."""
-        return {"units": self.units, "vehicle_names": list(self.names),
-                "initial_kinetic_energy": self.initial_kinetic_energy,
-                "models": [row.to_json_dict() for row in self.rows],
-                "skipped": dict(self.skipped)}
+        return {
+            "units": self.units,
+            "vehicle_names": list(self.names),
+            "initial_kinetic_energy": self.initial_kinetic_energy,
+            "models": [row.to_json_dict() for row in self.rows],
+            "skipped": dict(self.skipped),
+        }
 
     def _cells(self) -> tuple[list[str], list[list[str]]]:
         """Column headers and one list of cells per model."""
@@ -125,8 +138,7 @@ class Comparison:
             cells = [row.model]
             for veh in row.vehicles:
                 speed = "n/a" if veh.speed is None else f"{veh.speed:.2f} / {veh.direction:.1f}°"
-                cells += [speed, _cell(veh.yaw_rate, ".2f"),
-                          _cell(veh.delta_v_magnitude, ".2f")]
+                cells += [speed, _cell(veh.yaw_rate, ".2f"), _cell(veh.delta_v_magnitude, ".2f")]
             cells += [_cell(row.energy_percent[part], ".1f") for part in _ENERGY_PARTS]
             body.append(cells)
         return headers, body
@@ -135,13 +147,19 @@ class Comparison:
         """A plain-text table for people (like the seed's Tables 5-8)."""
         headers, body = self._cells()
         widths = [max(len(h), *(len(r[i]) for r in body)) for i, h in enumerate(headers)]
-        initial = ("unknown (no pre-impact motion)" if self.initial_kinetic_energy is None
-                   else f"{self.initial_kinetic_energy:.6g} {UNIT_LABELS[self.units]['energy']}")
-        lines = [f"model comparison, {self.units} units; energy as % of the initial kinetic "
-                 f"energy {initial}", ""]
+        initial = (
+            "unknown (no pre-impact motion)"
+            if self.initial_kinetic_energy is None
+            else f"{self.initial_kinetic_energy:.6g} {UNIT_LABELS[self.units]['energy']}"
+        )
+        lines = [
+            f"model comparison, {self.units} units; energy as % of the initial kinetic energy {initial}",
+            "",
+        ]
         for cells in [headers] + body:
-            lines.append("  ".join(c.rjust(wd) if i else c.ljust(wd)
-                                   for i, (c, wd) in enumerate(zip(cells, widths))))
+            lines.append(
+                "  ".join(c.rjust(wd) if i else c.ljust(wd) for i, (c, wd) in enumerate(zip(cells, widths)))
+            )
         lines += [""] + [f"skipped {name}: {reason}" for name, reason in self.skipped.items()]
         for row in self.rows:
             lines += [f"{row.model}: {warning}" for warning in row.warnings]
@@ -177,8 +195,12 @@ class Comparison:
         names = [row.model for row in self.rows]
         x = list(range(len(names)))
         for k, label in enumerate(self.names):
-            ax_dv.bar([i + (k - 0.5) * 0.38 for i in x],
-                      [row.vehicles[k].delta_v_magnitude for row in self.rows], 0.38, label=label)
+            ax_dv.bar(
+                [i + (k - 0.5) * 0.38 for i in x],
+                [row.vehicles[k].delta_v_magnitude for row in self.rows],
+                0.38,
+                label=label,
+            )
         ax_dv.set_ylabel(f"|delta-V| [{UNIT_LABELS[self.units]['velocity']}]")
         ax_dv.set_title("|delta-V| by vehicle", fontsize=10)
         bottom = [0.0] * len(names)
@@ -186,15 +208,24 @@ class Comparison:
             heights = [row.energy_percent[part] or 0.0 for row in self.rows]
             ax_e.bar(x, heights, 0.6, bottom=bottom, label=part)
             bottom = [b + h for b, h in zip(bottom, heights)]
-        crash = [(row.energy_percent["total"] or 0.0) if row.energy_percent["normal"] is None
-                 else 0.0 for row in self.rows]
+        crash = [
+            (row.energy_percent["total"] or 0.0) if row.energy_percent["normal"] is None else 0.0
+            for row in self.rows
+        ]
         ax_e.bar(x, crash, 0.6, label="crush energy (CRASH3)", hatch="//")
         ax_e.set_ylabel("energy loss [% of initial kinetic energy]")
         ax_e.set_title("energy loss by part", fontsize=10)
         energy_known = self.initial_kinetic_energy is not None
         if not energy_known:
-            ax_e.text(0.5, 0.5, "not known for a crush-only scene\n(no initial kinetic energy)",
-                      transform=ax_e.transAxes, ha="center", va="center", color="0.3")
+            ax_e.text(
+                0.5,
+                0.5,
+                "not known for a crush-only scene\n(no initial kinetic energy)",
+                transform=ax_e.transAxes,
+                ha="center",
+                va="center",
+                color="0.3",
+            )
             ax_e.set_yticks([])
         for ax in (ax_dv, ax_e):
             ax.set_xticks(x)
@@ -240,13 +271,15 @@ def compare(scene: Scene | Mapping | str | Path) -> Comparison:
     rows, skipped = [], {}
     for name in COMPARED_MODELS:
         try:
-            rows.append(_crash3_row(data, base, initial) if name == "crash3"
-                        else _model_row(data, name, initial))
+            rows.append(
+                _crash3_row(data, base, initial) if name == "crash3" else _model_row(data, name, initial)
+            )
         except SceneError as exc:
             skipped[name] = str(exc)
     if not rows:
-        raise SceneError("no model can solve this scene: "
-                         + "; ".join(f"{n}: {r}" for n, r in skipped.items()))
+        raise SceneError(
+            "no model can solve this scene: " + "; ".join(f"{n}: {r}" for n, r in skipped.items())
+        )
     names = (base.vehicles[0].name, base.vehicles[1].name)
     return Comparison(base.units, names, initial, tuple(rows), skipped, _scene_name(scene))
 
@@ -259,11 +292,18 @@ def _crush_only(data: Mapping, forward_error: SceneError) -> Comparison:
     except SceneError:
         raise forward_error from None
     result = crash3(data)
-    rows = (ModelRow("crash3", CRASH3_ASSUMPTIONS,
-                     tuple(_vehicle_row(None, None, c.delta_v, c.delta_v_magnitude)
-                           for c in result.vehicles),
-                     _crash3_energy(result), _percent(_crash3_energy(result), None), None, None,
-                     [w for w in result.warnings if w not in scene.warnings]),)
+    rows = (
+        ModelRow(
+            "crash3",
+            CRASH3_ASSUMPTIONS,
+            tuple(_vehicle_row(None, None, c.delta_v, c.delta_v_magnitude) for c in result.vehicles),
+            _crash3_energy(result),
+            _percent(_crash3_energy(result), None),
+            None,
+            None,
+            [w for w in result.warnings if w not in scene.warnings],
+        ),
+    )
     reason = f"needs a forward scene (pre-impact motion and impact geometry): {forward_error}"
     skipped = {name: reason for name in COMPARED_MODELS if name != "crash3"}
     names = (scene.vehicles[0].name, scene.vehicles[1].name)
@@ -303,13 +343,26 @@ def _model_row(data: Mapping, model: str, initial: float) -> ModelRow:
     scene = load_scene(_variant(data, model))
     result: Result = solve(scene)
     yaw = uses_yaw(model)
-    vehicles = tuple(_vehicle_row(v.velocity, v.yaw_rate if yaw else None, v.delta_v,
-                                  v.delta_v_magnitude) for v in result.vehicles)
-    energy = {"total": result.TL, "normal": result.TLn, "tangential": result.TLt,
-              "moment": result.TLm if yaw else None}
-    return ModelRow(model, PRESETS[model]["assumptions"], vehicles, energy,
-                    _percent(energy, initial), result.mu, result.mu_c,
-                    [w for w in result.warnings if w not in scene.warnings])
+    vehicles = tuple(
+        _vehicle_row(v.velocity, v.yaw_rate if yaw else None, v.delta_v, v.delta_v_magnitude)
+        for v in result.vehicles
+    )
+    energy = {
+        "total": result.TL,
+        "normal": result.TLn,
+        "tangential": result.TLt,
+        "moment": result.TLm if yaw else None,
+    }
+    return ModelRow(
+        model,
+        PRESETS[model]["assumptions"],
+        vehicles,
+        energy,
+        _percent(energy, initial),
+        result.mu,
+        result.mu_c,
+        [w for w in result.warnings if w not in scene.warnings],
+    )
 
 
 def _crash3_row(data: Mapping, base: Scene, initial: float) -> ModelRow:
@@ -319,23 +372,37 @@ def _crash3_row(data: Mapping, base: Scene, initial: float) -> ModelRow:
         raise SceneError(f"no crush table for {', '.join(missing)}")
     result = crash3(data)
     vehicles = tuple(
-        _vehicle_row((v.velocity[0] + c.delta_v[0], v.velocity[1] + c.delta_v[1]), None,
-                     c.delta_v, c.delta_v_magnitude)
-        for v, c in zip(base.vehicles, result.vehicles))
+        _vehicle_row(
+            (v.velocity[0] + c.delta_v[0], v.velocity[1] + c.delta_v[1]), None, c.delta_v, c.delta_v_magnitude
+        )
+        for v, c in zip(base.vehicles, result.vehicles)
+    )
     energy = _crash3_energy(result)
-    return ModelRow("crash3", CRASH3_ASSUMPTIONS, vehicles, energy, _percent(energy, initial),
-                    None, None, [w for w in result.warnings if w not in base.warnings])
+    return ModelRow(
+        "crash3",
+        CRASH3_ASSUMPTIONS,
+        vehicles,
+        energy,
+        _percent(energy, initial),
+        None,
+        None,
+        [w for w in result.warnings if w not in base.warnings],
+    )
 
 
 def _vehicle_row(velocity, yaw_rate, delta_v, magnitude) -> VehicleRow:
     """Final velocity also as speed and direction (degrees from +x); None
     without a final velocity (crush-only CRASH3)."""
     if velocity is None:
-        return VehicleRow(None, None, None, yaw_rate, None if delta_v is None else tuple(delta_v),
-                          magnitude)
-    return VehicleRow(velocity=tuple(velocity), speed=math.hypot(*velocity),
-                      direction=math.degrees(math.atan2(velocity[1], velocity[0])),
-                      yaw_rate=yaw_rate, delta_v=tuple(delta_v), delta_v_magnitude=magnitude)
+        return VehicleRow(None, None, None, yaw_rate, None if delta_v is None else tuple(delta_v), magnitude)
+    return VehicleRow(
+        velocity=tuple(velocity),
+        speed=math.hypot(*velocity),
+        direction=math.degrees(math.atan2(velocity[1], velocity[0])),
+        yaw_rate=yaw_rate,
+        delta_v=tuple(delta_v),
+        delta_v_magnitude=magnitude,
+    )
 
 
 def _initial_kinetic_energy(scene: Scene) -> float:
@@ -356,8 +423,10 @@ def _initial_kinetic_energy(scene: Scene) -> float:
 def _percent(energy: Mapping[str, float | None], initial: float | None) -> dict[str, float | None]:
     """Each energy as a percent of the initial kinetic energy (None stays None;
     all None without an initial kinetic energy)."""
-    return {k: None if v is None or initial is None or initial <= 0.0 else 100.0 * v / initial
-            for k, v in energy.items()}
+    return {
+        k: None if v is None or initial is None or initial <= 0.0 else 100.0 * v / initial
+        for k, v in energy.items()
+    }
 
 
 def _escape(cells: list[str]) -> list[str]:

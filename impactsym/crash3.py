@@ -81,8 +81,18 @@ from .result import UNIT_LABELS, road_speed_rows
 from .scene import Scene, SceneError, Vehicle, _mapping, _number, _positive, load_scene, scene_data
 from .single import solve
 
-__all__ = ["crash3", "Crash3Result", "Crash3Vehicle", "Crash3Options", "Crush", "INCHES_PER_FOOT",
-           "PDOF_MISMATCH_DEG", "ENERGY_MODES", "CORRECTIONS", "PDOF_CAP_DEG"]
+__all__ = [
+    "crash3",
+    "Crash3Result",
+    "Crash3Vehicle",
+    "Crash3Options",
+    "Crush",
+    "INCHES_PER_FOOT",
+    "PDOF_MISMATCH_DEG",
+    "ENERGY_MODES",
+    "CORRECTIONS",
+    "PDOF_CAP_DEG",
+]
 
 INCHES_PER_FOOT = 12.0
 # Energy of crush inputs in the scene's energy unit: SI J per (N/m·m²), US ft·lb per in·lb.
@@ -90,10 +100,20 @@ ENERGY_FACTOR = {"SI": 1.0, "US": 1.0 / INCHES_PER_FOOT}
 PROFILE_SIZES = tuple(_kernels.CRASH3_ENERGY)
 # Entered and implied PDOFs further apart than this are reported as a warning [deg].
 PDOF_MISMATCH_DEG = 5.0
-PDOF_CAP_DEG = 45.0    # EDCRASH: the correction factor 1 + tan²α is capped at 2
+PDOF_CAP_DEG = 45.0  # EDCRASH: the correction factor 1 + tan²α is capped at 2
 PDOF_LIMIT_DEG = 90.0  # beyond it the force would pull the damaged face out
-CRUSH_KEYS = ("A", "B", "width", "depths", "pdof", "moment_arm", "radius_of_gyration",
-              "category", "face", "class")
+CRUSH_KEYS = (
+    "A",
+    "B",
+    "width",
+    "depths",
+    "pdof",
+    "moment_arm",
+    "radius_of_gyration",
+    "category",
+    "face",
+    "class",
+)
 ENERGY_MODES = ("dissipated", "absorbed")
 CORRECTIONS = ("crash3", "woolley")
 OPTION_KEYS = ("restitution", "energy", "correction")
@@ -114,8 +134,7 @@ class Crash3Options:
     correction: str = "crash3"
 
     def to_json_dict(self) -> dict[str, Any]:
-        return {"restitution": self.restitution, "energy": self.energy,
-                "correction": self.correction}
+        return {"restitution": self.restitution, "energy": self.energy, "correction": self.correction}
 
 
 @dataclass(frozen=True)
@@ -157,9 +176,12 @@ class Crash3Vehicle:
     def to_json_dict(self) -> dict[str, Any]:
         """The vehicle entry of ``impactsym crash3 --json``."""
         return {
-            "name": self.name, "crush_energy": self.crush_energy,
-            "crush_energy_uncorrected": self.crush_energy_uncorrected, "pdof": self.pdof,
-            "effective_mass_factor": self.mass_factor, "moment_arm": self.moment_arm,
+            "name": self.name,
+            "crush_energy": self.crush_energy,
+            "crush_energy_uncorrected": self.crush_energy_uncorrected,
+            "pdof": self.pdof,
+            "effective_mass_factor": self.mass_factor,
+            "moment_arm": self.moment_arm,
             "delta_v": None if self.delta_v is None else list(self.delta_v),
             "delta_v_magnitude": self.delta_v_magnitude,
             "delta_v_effective_mass": self.delta_v_effective_mass,
@@ -186,13 +208,17 @@ class Crash3Result:
 
     def to_json_dict(self) -> dict[str, Any]:
         """The object printed by ``impactsym crash3 --json`` (conventions.md)."""
-        return {"units": self.units, "restitution": self.restitution,
-                "options": self.options.to_json_dict(),
-                "delta_v_reported": "centre of gravity (|P|/m); delta_v_effective_mass is "
-                                    "|P|/(gamma m) = delta_v_magnitude/gamma",
-                "vehicles": [v.to_json_dict() for v in self.vehicles],
-                "energy_total": self.energy_total, "impulse": self.impulse,
-                "warnings": list(self.warnings)}
+        return {
+            "units": self.units,
+            "restitution": self.restitution,
+            "options": self.options.to_json_dict(),
+            "delta_v_reported": "centre of gravity (|P|/m); delta_v_effective_mass is "
+            "|P|/(gamma m) = delta_v_magnitude/gamma",
+            "vehicles": [v.to_json_dict() for v in self.vehicles],
+            "energy_total": self.energy_total,
+            "impulse": self.impulse,
+            "warnings": list(self.warnings),
+        }
 
     def table(self) -> str:
         """A plain-text table for people."""
@@ -202,34 +228,44 @@ class Crash3Result:
         rows = [
             (f"crush energy [{energy}]", one.crush_energy_uncorrected, two.crush_energy_uncorrected),
             ("PDOF alpha [deg]", one.pdof, two.pdof),
-            (f"  corrected ({self.options.correction}) [{energy}]", one.crush_energy,
-             two.crush_energy),
+            (f"  corrected ({self.options.correction}) [{energy}]", one.crush_energy, two.crush_energy),
             ("effective-mass factor gamma", one.mass_factor, two.mass_factor),
             (f"|delta-V| of the CG [{speed}]", one.delta_v_magnitude, two.delta_v_magnitude),
-            (f"|delta-V| effective mass [{speed}]", one.delta_v_effective_mass,
-             two.delta_v_effective_mass),
-            *road_speed_rows(self.units, [("|delta-V| of the CG", (one.delta_v_magnitude,
-                                                                   two.delta_v_magnitude))]),
+            (f"|delta-V| effective mass [{speed}]", one.delta_v_effective_mass, two.delta_v_effective_mass),
+            *road_speed_rows(
+                self.units, [("|delta-V| of the CG", (one.delta_v_magnitude, two.delta_v_magnitude))]
+            ),
             (f"delta-V x [{speed}]", *(v.delta_v and v.delta_v[0] for v in self.vehicles)),
             (f"delta-V y [{speed}]", *(v.delta_v and v.delta_v[1] for v in self.vehicles)),
             ("PDOF implied by impulse-momentum [deg]", one.pdof_implied, two.pdof_implied),
-            (f"|delta-V| impulse-momentum [{speed}]", one.delta_v_magnitude_impulse_momentum,
-             two.delta_v_magnitude_impulse_momentum),
+            (
+                f"|delta-V| impulse-momentum [{speed}]",
+                one.delta_v_magnitude_impulse_momentum,
+                two.delta_v_magnitude_impulse_momentum,
+            ),
         ]
         width = max(14, len(one.name) + 2, len(two.name) + 2)
         opts = self.options
-        lines = [f"CRASH3, {self.units} units, restitution e = {opts.restitution:g}, crush energy "
-                 f"{opts.energy}, {opts.correction} oblique correction", "",
-                 f"{'':<40}{one.name:>{width}}{two.name:>{width}}"]
+        lines = [
+            f"CRASH3, {self.units} units, restitution e = {opts.restitution:g}, crush energy "
+            f"{opts.energy}, {opts.correction} oblique correction",
+            "",
+            f"{'':<40}{one.name:>{width}}{two.name:>{width}}",
+        ]
         lines += [f"{label:<40}{_cell(a):>{width}}{_cell(b):>{width}}" for label, a, b in rows]
         lines += ["", f"{'total energy [' + energy + ']':<40}{_cell(self.energy_total):>{width}}", ""]
-        lines += (["warnings:"] + [f"  - {w}" for w in self.warnings]) if self.warnings \
-            else ["warnings: none"]
+        lines += (
+            (["warnings:"] + [f"  - {w}" for w in self.warnings]) if self.warnings else ["warnings: none"]
+        )
         return "\n".join(lines)
 
 
-def crash3(scene: Scene | Mapping | str | Path, restitution: float | None = None,
-           energy: str | None = None, correction: str | None = None) -> Crash3Result:
+def crash3(
+    scene: Scene | Mapping | str | Path,
+    restitution: float | None = None,
+    energy: str | None = None,
+    correction: str | None = None,
+) -> Crash3Result:
     """CRASH3 delta-V of a scene whose moving vehicles carry ``crush`` tables.
 
     ``restitution`` e (0 ≤ e < 1 dissipated, ≤ 1 absorbed), ``energy``
@@ -245,23 +281,37 @@ def crash3(scene: Scene | Mapping | str | Path, restitution: float | None = None
     options = _options(data, restitution, energy, correction)
     geometry = not math.isnan(parsed.impact.normal_angle)
     gamma = math.radians(parsed.impact.normal_angle) if geometry else 0.0
-    crush = [None if v.fixed else _parse_crush(v.extra["crush"], f"vehicles[{i}].crush", parsed.units)
-             for i, v in enumerate(parsed.vehicles)]
-    energies = [_energy(c, parsed.units, f"vehicles[{i}].crush", options.correction)
-                if c else (0.0, 0.0, False) for i, c in enumerate(crush)]
+    crush = [
+        None if v.fixed else _parse_crush(v.extra["crush"], f"vehicles[{i}].crush", parsed.units)
+        for i, v in enumerate(parsed.vehicles)
+    ]
+    energies = [
+        _energy(c, parsed.units, f"vehicles[{i}].crush", options.correction) if c else (0.0, 0.0, False)
+        for i, c in enumerate(crush)
+    ]
     alphas = [math.radians(c.pdof) if c else 0.0 for c in crush]
-    values = {"E": energies[0][1] + energies[1][1], "e": options.restitution, "gamma": gamma,
-              "alpha1": alphas[0], "alpha2": alphas[1]}
+    values = {
+        "E": energies[0][1] + energies[1][1],
+        "e": options.restitution,
+        "gamma": gamma,
+        "alpha1": alphas[0],
+        "alpha2": alphas[1],
+    }
     for number, (vehicle, c) in enumerate(zip(parsed.vehicles, crush), start=1):
         values[f"m{number}"] = math.inf if vehicle.fixed else vehicle.mass
         values[f"rg{number}"] = _radius_of_gyration(vehicle, c, parsed.units)
         values[f"h{number}"] = _moment_arm(data, vehicle, c, gamma, geometry, number - 1)
     out = _run(_DELTA_V[options.energy], values, "cannot compute the CRASH3 delta-V")
     implied = _implied(data, options.restitution) if geometry else None
-    vehicles = tuple(_vehicle(v, c, energies[i], out, values, i + 1, implied, geometry)
-                     for i, (v, c) in enumerate(zip(parsed.vehicles, crush)))
-    warnings = _capped(crush, energies, options.correction) + _warnings(vehicles, crush, implied) \
+    vehicles = tuple(
+        _vehicle(v, c, energies[i], out, values, i + 1, implied, geometry)
+        for i, (v, c) in enumerate(zip(parsed.vehicles, crush))
+    )
+    warnings = (
+        _capped(crush, energies, options.correction)
+        + _warnings(vehicles, crush, implied)
         + list(parsed.warnings)
+    )
     return Crash3Result(parsed.units, options, vehicles, values["E"], out["P"], warnings)
 
 
@@ -275,10 +325,11 @@ def _options(data: Mapping, restitution, energy, correction) -> Crash3Options:
     pick = {k: (v if v is not None else table.get(k)) for k, v in given.items()}
     where = {k: (k if given[k] is not None else f"crash3.{k}") for k in given}
     mode = _word(pick["energy"], where["energy"], ENERGY_MODES, "dissipated")
-    return Crash3Options(restitution=_restitution(pick["restitution"], where["restitution"], mode),
-                         energy=mode,
-                         correction=_word(pick["correction"], where["correction"], CORRECTIONS,
-                                          "crash3"))
+    return Crash3Options(
+        restitution=_restitution(pick["restitution"], where["restitution"], mode),
+        energy=mode,
+        correction=_word(pick["correction"], where["correction"], CORRECTIONS, "crash3"),
+    )
 
 
 def _word(value: Any, path: str, allowed: tuple[str, ...], default: str) -> str:
@@ -313,8 +364,7 @@ def _parse_crush(raw: Any, path: str, units: str = "SI") -> Crush:
     a, b = _stiffness(data, path, units)
     depths = data["depths"]
     if not isinstance(depths, list) or len(depths) not in PROFILE_SIZES:
-        raise SceneError(f"must be a list of 2, 4 or 6 crush depths, got {_short(depths)}",
-                         f"{path}.depths")
+        raise SceneError(f"must be a list of 2, 4 or 6 crush depths, got {_short(depths)}", f"{path}.depths")
     crush_depths = tuple(_number(c, f"{path}.depths[{i}]") for i, c in enumerate(depths))
     for i, c in enumerate(crush_depths):
         if c < 0.0:
@@ -324,19 +374,21 @@ def _parse_crush(raw: Any, path: str, units: str = "SI") -> Crush:
         raise SceneError(f"must be > 0 (the damage width), got {width:g}", f"{path}.width")
     pdof = _number(data["pdof"], f"{path}.pdof")
     if abs(pdof) >= PDOF_LIMIT_DEG:
-        raise SceneError(f"|pdof| = {abs(pdof):g} must be < {PDOF_LIMIT_DEG:g} degrees from the "
-                         "inward normal of the damaged face (the force must push the face in)",
-                         f"{path}.pdof")
+        raise SceneError(
+            f"|pdof| = {abs(pdof):g} must be < {PDOF_LIMIT_DEG:g} degrees from the "
+            "inward normal of the damaged face (the force must push the face in)",
+            f"{path}.pdof",
+        )
     optional = {}
     if "moment_arm" in data:
         optional["moment_arm"] = _number(data["moment_arm"], f"{path}.moment_arm")
     if "radius_of_gyration" in data:
-        optional["radius_of_gyration"] = _positive(data["radius_of_gyration"],
-                                                   f"{path}.radius_of_gyration")
+        optional["radius_of_gyration"] = _positive(data["radius_of_gyration"], f"{path}.radius_of_gyration")
     if "class" in data:
         if data["class"] not in CLASSES:
-            raise SceneError(f"must be one of {', '.join(map(str, CLASSES))}, got "
-                             f"{_short(data['class'])}", f"{path}.class")
+            raise SceneError(
+                f"must be one of {', '.join(map(str, CLASSES))}, got {_short(data['class'])}", f"{path}.class"
+            )
         optional["vehicle_class"] = data["class"]
     return Crush(A=a, B=b, width=width, depths=crush_depths, pdof=pdof, **optional)
 
@@ -346,13 +398,14 @@ def _stiffness(data: Mapping, path: str, units: str) -> tuple[float, float]:
     explicit = [k for k in ("A", "B") if k in data]
     by_category = [k for k in ("category", "face") if k in data]
     if explicit and by_category:
-        raise SceneError(f"give either A and B or category and face, not both ({explicit[0]} and "
-                         f"{by_category[0]})", f"{path}.{by_category[0]}")
+        raise SceneError(
+            f"give either A and B or category and face, not both ({explicit[0]} and {by_category[0]})",
+            f"{path}.{by_category[0]}",
+        )
     if by_category:
         for key in ("category", "face"):
             if key not in data:
-                raise SceneError(f"missing (category needs face: {', '.join(FACES)})",
-                                 f"{path}.{key}")
+                raise SceneError(f"missing (category needs face: {', '.join(FACES)})", f"{path}.{key}")
         category, face = data["category"], data["face"]
         if isinstance(category, bool) or not isinstance(category, int) or not 1 <= category <= 9:
             raise SceneError(f"must be an integer 1-9, got {_short(category)}", f"{path}.category")
@@ -368,11 +421,11 @@ def _stiffness(data: Mapping, path: str, units: str) -> tuple[float, float]:
             raise SceneError("missing (give A and B, or category and face)", f"{path}.{key}")
     a, b = _number(data["A"], f"{path}.A"), _number(data["B"], f"{path}.B")
     if a < 0.0:
-        raise SceneError(f"must be >= 0 (the force per unit width at zero crush), got {a:g}",
-                         f"{path}.A")
+        raise SceneError(f"must be >= 0 (the force per unit width at zero crush), got {a:g}", f"{path}.A")
     if b <= 0.0:
-        raise SceneError(f"must be > 0 (the slope of force per unit width against crush), got {b:g}",
-                         f"{path}.B")
+        raise SceneError(
+            f"must be > 0 (the slope of force per unit width against crush), got {b:g}", f"{path}.B"
+        )
     return a, b
 
 
@@ -385,16 +438,22 @@ def _energy(crush: Crush, units: str, path: str, correction: str) -> tuple[float
     if out["status"]:
         raise SceneError(describe_status(out["status"]), path)
     factor = ENERGY_FACTOR[units]
-    return (out["E_crush"] * factor, out[_CORRECTED[correction]] * factor,
-            bool(out["flags"] & FLAG_PDOF_CAPPED))
+    return (
+        out["E_crush"] * factor,
+        out[_CORRECTED[correction]] * factor,
+        bool(out["flags"] & FLAG_PDOF_CAPPED),
+    )
 
 
 def _capped(crush, energies, correction: str) -> list[str]:
     """A warning per vehicle whose oblique correction was capped (EDCRASH)."""
     cap = {"crash3": "1 + tan^2(alpha) <= 2", "woolley": "1/cos(alpha) <= sqrt(2)"}[correction]
-    return [f"vehicles[{i}].crush.pdof = {c.pdof:g} degrees: the oblique correction is capped at "
-            f"{PDOF_CAP_DEG:g} degrees ({cap}), as EDCRASH does"
-            for i, (c, energy) in enumerate(zip(crush, energies)) if c is not None and energy[2]]
+    return [
+        f"vehicles[{i}].crush.pdof = {c.pdof:g} degrees: the oblique correction is capped at "
+        f"{PDOF_CAP_DEG:g} degrees ({cap}), as EDCRASH does"
+        for i, (c, energy) in enumerate(zip(crush, energies))
+        if c is not None and energy[2]
+    ]
 
 
 def _radius_of_gyration(vehicle: Vehicle, crush: Crush | None, units: str = "SI") -> float:
@@ -407,15 +466,18 @@ def _radius_of_gyration(vehicle: Vehicle, crush: Crush | None, units: str = "SI"
     if vehicle.yaw_inertia is None:
         if crush.vehicle_class is None:
             return math.inf
-        return math.sqrt(class_dimensions(crush.vehicle_class)["k_squared_in2"]) \
-            / _INCHES_PER_LENGTH[units]
-    out = _run(_kernels.CRASH3_RADIUS_OF_GYRATION,
-               {"mass": vehicle.mass, "inertia": vehicle.yaw_inertia}, "radius of gyration")
+        return math.sqrt(class_dimensions(crush.vehicle_class)["k_squared_in2"]) / _INCHES_PER_LENGTH[units]
+    out = _run(
+        _kernels.CRASH3_RADIUS_OF_GYRATION,
+        {"mass": vehicle.mass, "inertia": vehicle.yaw_inertia},
+        "radius of gyration",
+    )
     return out["rg"]
 
 
-def _moment_arm(data: Mapping, vehicle: Vehicle, crush: Crush | None, gamma: float,
-                geometry: bool, index: int) -> float:
+def _moment_arm(
+    data: Mapping, vehicle: Vehicle, crush: Crush | None, gamma: float, geometry: bool, index: int
+) -> float:
     """h [m | ft]: given, from the impact point and the PDOF (needs the impact
     block), or 0."""
     if crush is None:
@@ -424,13 +486,18 @@ def _moment_arm(data: Mapping, vehicle: Vehicle, crush: Crush | None, gamma: flo
         return crush.moment_arm
     if not geometry:
         if "impact_point" in data["vehicles"][index]:
-            raise SceneError("missing: the moment arm from vehicles[{index}].impact_point needs the "
-                             "crush-surface angle (or give crush.moment_arm)".replace(
-                                 "{index}", str(index)), "impact.normal_angle")
+            raise SceneError(
+                "missing: the moment arm from vehicles[{index}].impact_point needs the "
+                "crush-surface angle (or give crush.moment_arm)".replace("{index}", str(index)),
+                "impact.normal_angle",
+            )
         return 0.0
     rx, ry = vehicle.impact_point
-    out = _run(_kernels.CRASH3_MOMENT_ARM,
-               {"rx": rx, "ry": ry, "theta": gamma + math.radians(crush.pdof)}, "moment arm")
+    out = _run(
+        _kernels.CRASH3_MOMENT_ARM,
+        {"rx": rx, "ry": ry, "theta": gamma + math.radians(crush.pdof)},
+        "moment arm",
+    )
     return out["h"]
 
 
@@ -446,25 +513,46 @@ def _implied(data: Mapping, e: float) -> dict | None:
     """The common-velocity impulse-momentum solution of the same scene (e_m = 1,
     CRASH3's restitution): its PDOF [deg] and |ΔV| per vehicle, or None when the
     scene lacks the motion or geometry for it."""
-    variant = {**data, "model": "rigid",
-               "impact": {"normal_angle": data["impact"]["normal_angle"], "restitution": e,
-                          "impulse_ratio": "critical", "moment_restitution": 1.0}}
+    variant = {
+        **data,
+        "model": "rigid",
+        "impact": {
+            "normal_angle": data["impact"]["normal_angle"],
+            "restitution": e,
+            "impulse_ratio": "critical",
+            "moment_restitution": 1.0,
+        },
+    }
     try:
         result = solve(variant)
     except SceneError:
         return None
     out = _run(_kernels.CRASH3_IMPLIED_PDOF, {"Pn": result.Pn, "Pt": result.Pt}, "implied PDOF")
-    return {"pdof": math.degrees(out["pdof"]), "mu_c": result.mu_c,
-            "delta_v": [v.delta_v_magnitude for v in result.vehicles]}
+    return {
+        "pdof": math.degrees(out["pdof"]),
+        "mu_c": result.mu_c,
+        "delta_v": [v.delta_v_magnitude for v in result.vehicles],
+    }
 
 
-def _vehicle(vehicle: Vehicle, crush: Crush | None, energy, out, values, number: int,
-             implied: dict | None, geometry: bool = True) -> Crash3Vehicle:
+def _vehicle(
+    vehicle: Vehicle,
+    crush: Crush | None,
+    energy,
+    out,
+    values,
+    number: int,
+    implied: dict | None,
+    geometry: bool = True,
+) -> Crash3Vehicle:
     """Vehicle ``number``'s result from its energies, the delta-V kernel's output and
     the implied impulse-momentum solution (a fixed vehicle: zero energy and delta-V)."""
     return Crash3Vehicle(
-        name=vehicle.name, crush_energy=energy[1], crush_energy_uncorrected=energy[0],
-        pdof=crush.pdof if crush else 0.0, mass_factor=out[f"mass_factor{number}"],
+        name=vehicle.name,
+        crush_energy=energy[1],
+        crush_energy_uncorrected=energy[0],
+        pdof=crush.pdof if crush else 0.0,
+        mass_factor=out[f"mass_factor{number}"],
         moment_arm=values[f"h{number}"],
         delta_v=(out[f"dV{number}x"], out[f"dV{number}y"]) if geometry else None,
         delta_v_magnitude=out[f"dV{number}"],
@@ -479,22 +567,27 @@ def _warnings(vehicles, crush, implied: dict | None) -> list[str]:
     warnings = []
     entered = [c.pdof for c in crush if c is not None]
     if len(entered) == 2 and abs(entered[0] - entered[1]) > 1e-9:
-        warnings.append(f"the entered PDOFs differ ({entered[0]:g} and {entered[1]:g} degrees): "
-                        "the impulses on the two vehicles are not equal and opposite, so "
-                        "momentum is not conserved")
+        warnings.append(
+            f"the entered PDOFs differ ({entered[0]:g} and {entered[1]:g} degrees): "
+            "the impulses on the two vehicles are not equal and opposite, so "
+            "momentum is not conserved"
+        )
     if implied is None:
         return warnings
     if abs(implied["pdof"]) > PDOF_LIMIT_DEG:
-        warnings.append(f"the impulse-momentum solution's PDOF ({implied['pdof']:.1f} degrees) "
-                        "is beyond CRASH3's 45-degree limit: a sideswipe-like impact, which "
-                        "CRASH3 cannot model (seed)")
+        warnings.append(
+            f"the impulse-momentum solution's PDOF ({implied['pdof']:.1f} degrees) "
+            "is beyond CRASH3's 45-degree limit: a sideswipe-like impact, which "
+            "CRASH3 cannot model (seed)"
+        )
     for index, (vehicle, c) in enumerate(zip(vehicles, crush)):
         if c is not None and abs(c.pdof - implied["pdof"]) > PDOF_MISMATCH_DEG:
             warnings.append(
                 f"vehicles[{index}] ({vehicle.name}): PDOF entered {c.pdof:g} degrees, but the "
                 f"common velocity CRASH3 assumes for |delta-V| (mu = mu_c = {implied['mu_c']:.3g}) "
                 f"implies {implied['pdof']:.1f} degrees: CRASH3 takes |delta-V| from mu = mu_max "
-                "and its direction from the entered PDOF (seed)")
+                "and its direction from the entered PDOF (seed)"
+            )
     return warnings
 
 
@@ -521,5 +614,7 @@ def crush_tables(scene: Scene | Mapping | str | Path) -> tuple[Crush | None, ...
     """Each vehicle's validated ``crush`` table (None for a fixed body), as
     :func:`crash3` reads them (for the CRASH3 diagram of :mod:`impactsym.plot_crash3`)."""
     parsed = load_scene(scene_data(scene), kind="crash3")
-    return tuple(None if v.fixed else _parse_crush(v.extra["crush"], f"vehicles[{i}].crush", parsed.units)
-                 for i, v in enumerate(parsed.vehicles))
+    return tuple(
+        None if v.fixed else _parse_crush(v.extra["crush"], f"vehicles[{i}].crush", parsed.units)
+        for i, v in enumerate(parsed.vehicles)
+    )

@@ -38,11 +38,14 @@ DATA = Path(__file__).resolve().parent / "data"
 FACES = ("front", "rear", "side")
 CATEGORIES = tuple(range(1, 10))
 LBF = 4.4482216152605  # N per pound-force (exact by definition)
-INCH = 0.0254          # m per inch (exact by definition)
+INCH = 0.0254  # m per inch (exact by definition)
 # Category 6 shares category 5's row in the source table.
 _SAME_ROW = {6: 5}
-_DESCRIPTION = {7: "vans and other (pickup-based utilities): front and rear only",
-                8: "pickups: front and rear only", 9: "front-wheel-drive cars: front only"}
+_DESCRIPTION = {
+    7: "vans and other (pickup-based utilities): front and rear only",
+    8: "pickups: front and rear only",
+    9: "front-wheel-drive cars: front only",
+}
 
 
 @dataclass(frozen=True)
@@ -59,9 +62,10 @@ class Stiffness:
 def _stiffness_table() -> dict[tuple[int, str], tuple[float, float]]:
     """(category, face) → (A lb/in, B lb/in²) as published."""
     with open(DATA / "crash3_stiffness_categories.csv", newline="") as handle:
-        return {(int(row["category"]), row["face"]): (float(row["A_lb_per_in"]),
-                                                      float(row["B_lb_per_in2"]))
-                for row in csv.DictReader(handle)}
+        return {
+            (int(row["category"]), row["face"]): (float(row["A_lb_per_in"]), float(row["B_lb_per_in2"]))
+            for row in csv.DictReader(handle)
+        }
 
 
 def stiffness(category: int, face: str, units: str = "US") -> Stiffness:
@@ -74,8 +78,9 @@ def stiffness(category: int, face: str, units: str = "US") -> Stiffness:
         raise ValueError(f"category must be an integer 1-9, got {category!r}")
     key = (_SAME_ROW.get(category, category), face)
     if key not in _stiffness_table():
-        raise ValueError(f"category {category} has no {face} stiffness "
-                         f"({_DESCRIPTION.get(category, 'no such row')})")
+        raise ValueError(
+            f"category {category} has no {face} stiffness ({_DESCRIPTION.get(category, 'no such row')})"
+        )
     a, b = _stiffness_table()[key]
     if units == "SI":
         a, b = a * LBF / INCH, b * LBF / INCH**2

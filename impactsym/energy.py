@@ -11,8 +11,22 @@ from . import _kernels
 from .codes import describe_status
 
 
-def delta_v_from_energy(TL, m1, m2, *, e=0.0, mu=0.0, r=0.0, gamma=0.0,
-                        I1=math.inf, I2=math.inf, r1x=0.0, r1y=0.0, r2x=0.0, r2y=0.0):
+def delta_v_from_energy(
+    TL,
+    m1,
+    m2,
+    *,
+    e=0.0,
+    mu=0.0,
+    r=0.0,
+    gamma=0.0,
+    I1=math.inf,
+    I2=math.inf,
+    r1x=0.0,
+    r1y=0.0,
+    r2x=0.0,
+    r2y=0.0,
+):
     """Scalar delta-V of each vehicle from the energy loss `TL` (seed eqs 27–29).
 
     Planar impact without moment impulse (e_m = 1) with restitution `e`, impulse
@@ -26,8 +40,9 @@ def delta_v_from_energy(TL, m1, m2, *, e=0.0, mu=0.0, r=0.0, gamma=0.0,
     delta-V exists; arrays (broadcast together) give arrays plus a ``status``
     column (see `impactsym.codes`).
     """
-    args = dict(m1=m1, m2=m2, I1=I1, I2=I2, r1x=r1x, r1y=r1y, r2x=r2x, r2y=r2y,
-                gamma=gamma, e=e, mu=mu, r=r, TL=TL)
+    args = dict(
+        m1=m1, m2=m2, I1=I1, I2=I2, r1x=r1x, r1y=r1y, r2x=r2x, r2y=r2y, gamma=gamma, e=e, mu=mu, r=r, TL=TL
+    )
     ks = _kernels.DELTA_V
     if all(np.ndim(v) == 0 for v in args.values()):
         *outs, status, _ = ks.scene(*[float(args[k]) for k in ks.inputs])

@@ -85,8 +85,7 @@ class Explorer:
         from ._kernels import PRESETS
 
         preset = PRESETS[self.scene.model]
-        self.used = tuple(key for key in _COEFFICIENTS
-                          if key in (*preset["required"], *preset["optional"]))
+        self.used = tuple(key for key in _COEFFICIENTS if key in (*preset["required"], *preset["optional"]))
         self.fixed_critical = preset["fixed"].get("impulse_ratio") == CRITICAL
         impact = self.scene.impact
         self.result = None
@@ -107,25 +106,61 @@ class Explorer:
         layout = widgets.Layout(width="340px")
         self.sliders = {
             "restitution": widgets.FloatSlider(
-                value=float(coefficient("restitution", 0.0)), min=0.0, max=1.0, step=0.01,
-                description="e", style=style, layout=layout, continuous_update=True),
+                value=float(coefficient("restitution", 0.0)),
+                min=0.0,
+                max=1.0,
+                step=0.01,
+                description="e",
+                style=style,
+                layout=layout,
+                continuous_update=True,
+            ),
             "impulse_ratio": widgets.FloatSlider(
-                value=mu, min=min(mu, 0.0) - 0.1, max=max(mu, 0.0) + 0.1, step=0.001,
-                description="μ", readout_format=".3f", style=dict(style), layout=layout),
+                value=mu,
+                min=min(mu, 0.0) - 0.1,
+                max=max(mu, 0.0) + 0.1,
+                step=0.001,
+                description="μ",
+                readout_format=".3f",
+                style=dict(style),
+                layout=layout,
+            ),
             "moment_restitution": widgets.FloatSlider(
-                value=float(coefficient("moment_restitution", 1.0)), min=-1.0, max=1.0, step=0.01,
-                description="e_m", style=style, layout=layout),
+                value=float(coefficient("moment_restitution", 1.0)),
+                min=-1.0,
+                max=1.0,
+                step=0.01,
+                description="e_m",
+                style=style,
+                layout=layout,
+            ),
             "slip": widgets.FloatSlider(
-                value=float(coefficient("slip", 0.0)), min=0.0, max=1.0, step=0.01,
-                description="slip", style=style, layout=layout),
+                value=float(coefficient("slip", 0.0)),
+                min=0.0,
+                max=1.0,
+                step=0.01,
+                description="slip",
+                style=style,
+                layout=layout,
+            ),
             "normal_angle": widgets.FloatSlider(
-                value=impact.normal_angle, min=impact.normal_angle - 90.0, max=impact.normal_angle + 90.0,
-                step=1.0, description="crush Γ [°]", style=style, layout=layout,
-                tooltip="normal angle Γ: the crush surface lies along t, at Γ + 90°"),
+                value=impact.normal_angle,
+                min=impact.normal_angle - 90.0,
+                max=impact.normal_angle + 90.0,
+                step=1.0,
+                description="crush Γ [°]",
+                style=style,
+                layout=layout,
+                tooltip="normal angle Γ: the crush surface lies along t, at Γ + 90°",
+            ),
         }
-        self.critical = widgets.Checkbox(value=critical, description="μ = μ_c (critical)",
-                                         disabled=self.fixed_critical or "impulse_ratio" not in self.used,
-                                         indent=False, layout=widgets.Layout(margin="0 0 0 114px"))
+        self.critical = widgets.Checkbox(
+            value=critical,
+            description="μ = μ_c (critical)",
+            disabled=self.fixed_critical or "impulse_ratio" not in self.used,
+            indent=False,
+            layout=widgets.Layout(margin="0 0 0 114px"),
+        )
         self.mu_note = widgets.HTML(layout=widgets.Layout(margin="0 0 0 114px"))
         self.angle_note = widgets.HTML(layout=widgets.Layout(margin="0 0 0 114px"))
         for key, slider in self.sliders.items():
@@ -147,21 +182,34 @@ class Explorer:
         for slider in self.sliders.values():
             slider.observe(self._changed, names="value")
         self.critical.observe(self._changed, names="value")
-        controls = widgets.VBox([
-            widgets.HTML(self._header_html(preset)),
-            self.sliders["restitution"], self.sliders["impulse_ratio"], self.critical, self.mu_note,
-            self.sliders["moment_restitution"], self.sliders["slip"], self.sliders["normal_angle"],
-            self.angle_note, self.readout,
-        ], layout=widgets.Layout(width="380px"))
+        controls = widgets.VBox(
+            [
+                widgets.HTML(self._header_html(preset)),
+                self.sliders["restitution"],
+                self.sliders["impulse_ratio"],
+                self.critical,
+                self.mu_note,
+                self.sliders["moment_restitution"],
+                self.sliders["slip"],
+                self.sliders["normal_angle"],
+                self.angle_note,
+                self.readout,
+            ],
+            layout=widgets.Layout(width="380px"),
+        )
         self.widget = widgets.HBox([controls, self.image])
         self.update()
 
     def _header_html(self, preset: Mapping) -> str:
         names = {"restitution": "e", "impulse_ratio": "μ", "moment_restitution": "e_m"}
-        fixed = ", ".join(f"{names.get(key, key)} = {'μ_c' if value == CRITICAL else value}"
-                          for key, value in preset["fixed"].items())
-        text = (f"<b>{html.escape(self.name)}</b>: {html.escape(self.scene.model)} model, "
-                f"{self.scene.units} units")
+        fixed = ", ".join(
+            f"{names.get(key, key)} = {'μ_c' if value == CRITICAL else value}"
+            for key, value in preset["fixed"].items()
+        )
+        text = (
+            f"<b>{html.escape(self.name)}</b>: {html.escape(self.scene.model)} model, "
+            f"{self.scene.units} units"
+        )
         if fixed:
             text += f"<br><small>fixed by the model: {html.escape(fixed)}</small>"
         return text
@@ -210,8 +258,10 @@ class Explorer:
     def _update_mu(self) -> None:
         slider = self.sliders["impulse_ratio"]
         gamma = self.sliders["normal_angle"].value
-        self.angle_note.value = (f"<small>normal Γ = {gamma:g}°, crush surface along "
-                                 f"{(gamma + 90.0 + 180.0) % 360.0 - 180.0:g}°</small>")
+        self.angle_note.value = (
+            f"<small>normal Γ = {gamma:g}°, crush surface along "
+            f"{(gamma + 90.0 + 180.0) % 360.0 - 180.0:g}°</small>"
+        )
         if "impulse_ratio" not in self.used:
             return
         critical = self.critical.value
@@ -233,8 +283,10 @@ class Explorer:
         if inside:
             self.mu_note.value = f"<small>physical: μ between 0 and μ_c ({span})</small>"
         else:
-            self.mu_note.value = (f"<small style='color:crimson'>μ = {mu:.3g} is beyond the physical "
-                                  f"range {span}: flagged</small>")
+            self.mu_note.value = (
+                f"<small style='color:crimson'>μ = {mu:.3g} is beyond the physical "
+                f"range {span}: flagged</small>"
+            )
 
     # ------------------------------------------------------------------ readout and diagram
 
@@ -252,16 +304,23 @@ class Explorer:
     def _readout_html(self) -> str:
         setting = self._setting_html()
         if self.result is None:
-            return (f"{setting}<p style='color:crimson'><b>cannot solve:</b> "
-                    f"{html.escape(self.error or '')}</p>")
+            return (
+                f"{setting}<p style='color:crimson'><b>cannot solve:</b> {html.escape(self.error or '')}</p>"
+            )
         r = self.result
         labels = UNIT_LABELS[r.units]
         speed, energy = labels["velocity"], labels["energy"]
         rows = []
         for vehicle in r.vehicles:
             dx, dy = vehicle.delta_v
-            direction = f" at {math.degrees(math.atan2(dy, dx)) % 360.0:.0f}°" if vehicle.delta_v_magnitude > 0 else ""
-            rows.append((f"|ΔV| {html.escape(vehicle.name)}", f"{vehicle.delta_v_magnitude:.4g} {speed}{direction}"))
+            direction = (
+                f" at {math.degrees(math.atan2(dy, dx)) % 360.0:.0f}°"
+                if vehicle.delta_v_magnitude > 0
+                else ""
+            )
+            rows.append(
+                (f"|ΔV| {html.escape(vehicle.name)}", f"{vehicle.delta_v_magnitude:.4g} {speed}{direction}")
+            )
         rows += [
             ("energy loss TL", f"{r.TL:.5g} {energy}"),
             ("&nbsp;&nbsp;normal TLn", f"{r.TLn:.5g} {energy}"),
@@ -275,7 +334,9 @@ class Explorer:
             status = f"<div style='color:crimson'><b>flags {r.flags}:</b><ul>{flags}</ul></div>"
         else:
             extra = "".join(f"<li>{html.escape(text)}</li>" for text in r.warnings)
-            status = "<div style='color:green'><b>flags: none</b></div>" + (f"<ul>{extra}</ul>" if extra else "")
+            status = "<div style='color:green'><b>flags: none</b></div>" + (
+                f"<ul>{extra}</ul>" if extra else ""
+            )
         return f"{setting}<table>{body}</table>{status}"
 
     def _draw(self, data: dict) -> None:
@@ -296,14 +357,17 @@ class Explorer:
         if self._velocity_scale is None:
             self._velocity_scale = self._plot.default_velocity_scale(source, **options)
         # no title on the picture: the header and readout carry it (a title costs ~7 ms to draw)
-        handles, legend_title = self._plot._render(ax, source, velocity_scale=self._velocity_scale,
-                                                   title="", **options)
+        handles, legend_title = self._plot._render(
+            ax, source, velocity_scale=self._velocity_scale, title="", **options
+        )
         limits = (ax.get_xlim(), ax.get_ylim())
         limits = _grown(self._limits, limits)
         ax.set_xlim(*limits[0])
         ax.set_ylim(*limits[1])
         self._plot._place_labels(ax)  # now that the limits are final
-        dynamic = sorted([*ax.patches, *ax.lines, *ax.texts, ax.title], key=lambda artist: artist.get_zorder())
+        dynamic = sorted(
+            [*ax.patches, *ax.lines, *ax.texts, ax.title], key=lambda artist: artist.get_zorder()
+        )
         for artist in dynamic:
             artist.set_animated(True)
         key = (limits, legend_title, tuple(handle.get_label() for handle in handles))

@@ -37,10 +37,16 @@ def invert_batch(columns, model: str = "rigid"):
     mu_c TL TLn TLt TLm status flags``; status 7 (e too small) and 8 (e_m too
     small) mark rows whose finals do not determine the initials.
     """
-    everywhere = tuple(c for name in _kernels.INVERSE_MODELS
-                       for c in _kernels.inverse_kernel_for(name).inputs)
-    return run_columns(_kernels.inverse_kernel_for(model), columns, _kernels.INVERSE_OUTPUTS,
-                       f"the {model} model", everywhere)
+    everywhere = tuple(
+        c for name in _kernels.INVERSE_MODELS for c in _kernels.inverse_kernel_for(name).inputs
+    )
+    return run_columns(
+        _kernels.inverse_kernel_for(model),
+        columns,
+        _kernels.INVERSE_OUTPUTS,
+        f"the {model} model",
+        everywhere,
+    )
 
 
 def invert(scene: Scene | Mapping | str | Path) -> Result:
@@ -49,8 +55,7 @@ def invert(scene: Scene | Mapping | str | Path) -> Result:
     the INITIAL ones; delta-V is final minus initial."""
     scene = load_scene(scene, kind="inverse")
     values = _inputs(scene)
-    out = _kernels.run_one(_kernels.inverse_kernel_for(scene.family), values,
-                           _kernels.INVERSE_OUTPUTS)
+    out = _kernels.run_one(_kernels.inverse_kernel_for(scene.family), values, _kernels.INVERSE_OUTPUTS)
     if out["status"] != 0:
         overflow = overflow_error(scene, out["status"])
         if overflow:
@@ -60,11 +65,22 @@ def invert(scene: Scene | Mapping | str | Path) -> Result:
         raise SceneError(f"{reason}; {hint}" if hint else reason)
     flags = out["flags"]
     return Result(
-        model=scene.model, units=scene.units, critical=False,
+        model=scene.model,
+        units=scene.units,
+        critical=False,
         vehicles=tuple(_vehicle(v, out, values, i) for i, v in enumerate(scene.vehicles, 1)),
-        Pn=out["Pn"], Pt=out["Pt"], M=out["M"], mu=scene.impact.impulse_ratio,
-        mu_c=out["mu_c"], TL=out["TL"], TLn=out["TLn"], TLt=out["TLt"], TLm=out["TLm"],
-        flags=flags, warnings=describe_flags(flags) + scene_warnings(scene), direction="inverse",
+        Pn=out["Pn"],
+        Pt=out["Pt"],
+        M=out["M"],
+        mu=scene.impact.impulse_ratio,
+        mu_c=out["mu_c"],
+        TL=out["TL"],
+        TLn=out["TLn"],
+        TLt=out["TLt"],
+        TLm=out["TLm"],
+        flags=flags,
+        warnings=describe_flags(flags) + scene_warnings(scene),
+        direction="inverse",
     )
 
 
@@ -81,5 +97,10 @@ def _inputs(scene: Scene) -> dict:
 def _vehicle(vehicle, out, values, number: int) -> VehicleResult:
     initial = (out[f"v{number}x"], out[f"v{number}y"])
     delta = (values[f"V{number}x"] - initial[0], values[f"V{number}y"] - initial[1])
-    return VehicleResult(name=vehicle.name, velocity=initial, yaw_rate=out[f"w{number}"],
-                         delta_v=delta, delta_v_magnitude=math.hypot(*delta))
+    return VehicleResult(
+        name=vehicle.name,
+        velocity=initial,
+        yaw_rate=out[f"w{number}"],
+        delta_v=delta,
+        delta_v_magnitude=math.hypot(*delta),
+    )

@@ -76,8 +76,15 @@ from .plot_sweep import save_sweep, sweep
 from .result import UNIT_LABELS
 from .scene import Scene, SceneError, _read_file, load_scene
 
-__all__ = ["scene", "save_plot", "sweep", "save_sweep", "add_plot_argument", "default_velocity_scale",
-           "PRE_IMPACT_KINDS"]
+__all__ = [
+    "scene",
+    "save_plot",
+    "sweep",
+    "save_sweep",
+    "add_plot_argument",
+    "default_velocity_scale",
+    "PRE_IMPACT_KINDS",
+]
 
 #: Result kinds whose ``velocity``/``yaw_rate`` are the pre-impact motion.
 PRE_IMPACT_KINDS = ("invert", "inverse", "reconstruct", "reconstruction")
@@ -125,8 +132,16 @@ class _Body:
 # --------------------------------------------------------------------------- public
 
 
-def scene(scene_or_result: Any, ax=None, *, scene: SceneLike | None = None, result: Any = None,
-          velocity_scale: float | None = None, legend: bool = True, title: str | None = None):
+def scene(
+    scene_or_result: Any,
+    ax=None,
+    *,
+    scene: SceneLike | None = None,
+    result: Any = None,
+    velocity_scale: float | None = None,
+    legend: bool = True,
+    title: str | None = None,
+):
     """Draw a scene, or a solved scene, on ``ax`` (a new figure when ``None``).
 
     ``scene_or_result`` is a scene (a :class:`~impactsym.scene.Scene`, a
@@ -148,8 +163,15 @@ def scene(scene_or_result: Any, ax=None, *, scene: SceneLike | None = None, resu
     return ax
 
 
-def save_plot(scene_or_result: Any, path: str | Path, *, scene: SceneLike | None = None,
-              result: Any = None, dpi: int = 120, **options) -> Path:
+def save_plot(
+    scene_or_result: Any,
+    path: str | Path,
+    *,
+    scene: SceneLike | None = None,
+    result: Any = None,
+    dpi: int = 120,
+    **options,
+) -> Path:
     """Draw like :func:`scene` and write the figure to ``path``.
 
     The format follows the suffix (``.png``, ``.svg``, ``.pdf``, ...). Uses a
@@ -171,8 +193,15 @@ def save_plot(scene_or_result: Any, path: str | Path, *, scene: SceneLike | None
     fig = Figure(figsize=(9.0, 6.5), layout="constrained")
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
-    _draw(ax, the_scene, the_result, position, options.pop("velocity_scale", None),
-          options.pop("legend", True), options.pop("title", None))
+    _draw(
+        ax,
+        the_scene,
+        the_result,
+        position,
+        options.pop("velocity_scale", None),
+        options.pop("legend", True),
+        options.pop("title", None),
+    )
     if options:
         raise TypeError(f"save_plot: unexpected options {', '.join(sorted(options))}")
     path = Path(path)
@@ -188,13 +217,17 @@ def add_plot_argument(parser: argparse.ArgumentParser) -> None:
     reports a usage error (one line, exit code 2 in the CLI).
     """
     parser.add_argument(
-        "--plot", metavar="PATH", type=_plot_path, default=None,
+        "--plot",
+        metavar="PATH",
+        type=_plot_path,
+        default=None,
         help="also draw the scene diagram to PATH (.png, .svg, .pdf; needs matplotlib)",
     )
 
 
-def default_velocity_scale(scene_or_result: Any, *, scene: SceneLike | None = None,
-                           result: Any = None) -> float:
+def default_velocity_scale(
+    scene_or_result: Any, *, scene: SceneLike | None = None, result: Any = None
+) -> float:
     """The ``velocity_scale`` :func:`scene` would choose: the drawn length (scene
     length unit) of one velocity unit, so that the longest arrow is about twice
     the vehicles' size. Pass it back to keep arrows comparable between drawings."""
@@ -214,7 +247,8 @@ def _plot_path(text: str) -> Path:
     path = Path(text)
     if path.suffix.lower() not in _FORMATS:
         raise argparse.ArgumentTypeError(
-            f"--plot {text}: unknown image type {path.suffix or '(none)'!r} (use .png, .svg or .pdf)")
+            f"--plot {text}: unknown image type {path.suffix or '(none)'!r} (use .png, .svg or .pdf)"
+        )
     try:
         require("matplotlib", extra="plot", what="--plot", load=False)
     except ImportError as exc:
@@ -241,7 +275,8 @@ def _resolve(obj: Any, scene: SceneLike | None, result: Any) -> tuple[Scene, Any
         if scene is None:
             raise TypeError(
                 f"plot: a {type(result).__name__} does not carry its scene; pass scene=... "
-                "(the scene file or Scene it was solved from)")
+                "(the scene file or Scene it was solved from)"
+            )
     if result is not None and not hasattr(result, "vehicles"):
         raise TypeError(f"plot: expected a result with vehicles, got {type(result).__name__}")
     kind = _SCENE_KINDS.get(str(getattr(result, "kind", "solve")), "forward")
@@ -351,7 +386,9 @@ def _outline(vehicle, velocity) -> tuple[float, float, float] | None:
         return None
     heading = _num(vehicle.extra.get("heading"))
     if heading is None:
-        heading = math.degrees(math.atan2(velocity[1], velocity[0])) if velocity and _norm(velocity) > 0 else 0.0
+        heading = (
+            math.degrees(math.atan2(velocity[1], velocity[0])) if velocity and _norm(velocity) > 0 else 0.0
+        )
     return (length, width, heading)
 
 
@@ -385,8 +422,20 @@ def _bodies(scene: Scene, result: Any, centre, size: float) -> list[_Body]:
         else:
             offset = 0.5 * outline[0] if outline else _PARTICLE_OFFSET * size
             cg = _add(centre, _scale(n, offset if index else -offset))
-        bodies.append(_Body(vehicle.name, vehicle.fixed, cg, outline, v0, v1, dv, w0, w1,
-                            heading=_num(vehicle.extra.get("heading"))))
+        bodies.append(
+            _Body(
+                vehicle.name,
+                vehicle.fixed,
+                cg,
+                outline,
+                v0,
+                v1,
+                dv,
+                w0,
+                w1,
+                heading=_num(vehicle.extra.get("heading")),
+            )
+        )
     _set_forces(bodies, result, n, t)
     return bodies
 
@@ -466,8 +515,21 @@ class _Canvas:
     def arrow(self, tail, head, color, lw=2.0, ls="-", alpha=1.0, zorder=4, scale=14):
         if _norm(_sub(head, tail)) <= 0:
             return
-        self.ax.add_patch(self._arrow(tail, head, arrowstyle="-|>", mutation_scale=scale, color=color, lw=lw,
-                                      linestyle=ls, alpha=alpha, shrinkA=0, shrinkB=0, zorder=zorder))
+        self.ax.add_patch(
+            self._arrow(
+                tail,
+                head,
+                arrowstyle="-|>",
+                mutation_scale=scale,
+                color=color,
+                lw=lw,
+                linestyle=ls,
+                alpha=alpha,
+                shrinkA=0,
+                shrinkB=0,
+                zorder=zorder,
+            )
+        )
         self.points += [tail, head]
 
     def arc(self, centre, radius, start_deg, sweep_deg, color, ls, zorder=5):
@@ -476,8 +538,17 @@ class _Canvas:
         for step in range(steps + 1):
             angle = math.radians(start_deg + sweep_deg * step / steps)
             points.append((centre[0] + radius * math.cos(angle), centre[1] + radius * math.sin(angle)))
-        self.ax.add_patch(self._arrow(path=self._path(points), arrowstyle="-|>", mutation_scale=11,
-                                      color=color, lw=1.6, linestyle=ls, zorder=zorder))
+        self.ax.add_patch(
+            self._arrow(
+                path=self._path(points),
+                arrowstyle="-|>",
+                mutation_scale=11,
+                color=color,
+                lw=1.6,
+                linestyle=ls,
+                zorder=zorder,
+            )
+        )
         self.points += points
         return points[-1]
 
@@ -497,9 +568,18 @@ class _Canvas:
         """A label near ``anchor`` (data coordinates); :func:`_place_labels` later
         moves it around the anchor, trying the screen direction ``prefer_deg`` first
         and the text ``wrapped`` (on two lines) when the one line finds no free place."""
-        label = self.ax.annotate(text, anchor, xytext=(0.0, 0.0), textcoords="offset points", ha="center",
-                                 va="center", zorder=6, annotation_clip=False,
-                                 bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.75), **style)
+        label = self.ax.annotate(
+            text,
+            anchor,
+            xytext=(0.0, 0.0),
+            textcoords="offset points",
+            ha="center",
+            va="center",
+            zorder=6,
+            annotation_clip=False,
+            bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.75),
+            **style,
+        )
         label.set_in_layout(False)  # kept inside the axes by _place_labels; must not move the layout
         _PREFERRED[label] = (prefer_deg, wrapped)
         self.points.append(anchor)
@@ -521,7 +601,21 @@ def _angle(vector) -> float:
 #: Scene labels (annotations made by ``_Canvas.label``): the screen direction tried
 #: first and the label on two lines (or None).
 _PREFERRED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-_RADII = (2.0, 6.0, 11.0, 17.0, 24.0, 32.0, 42.0, 54.0, 68.0, 84.0, 102.0, 122.0, 145.0)  # label distance from its anchor [points]
+_RADII = (
+    2.0,
+    6.0,
+    11.0,
+    17.0,
+    24.0,
+    32.0,
+    42.0,
+    54.0,
+    68.0,
+    84.0,
+    102.0,
+    122.0,
+    145.0,
+)  # label distance from its anchor [points]
 _DIRECTIONS = 24
 _LEADER_FROM = 14.0  # labels further than this from their anchor [points] get a leader line
 
@@ -530,8 +624,10 @@ def _candidates(prefer_deg: float):
     """``(offset in points, ha, va)`` around an anchor: nearest first, and at each
     distance the directions closest to ``prefer_deg`` first. The alignment puts
     the side of the text facing the anchor at the offset."""
-    angles = sorted((360.0 * i / _DIRECTIONS for i in range(_DIRECTIONS)),
-                    key=lambda a: abs((a - prefer_deg + 180.0) % 360.0 - 180.0))
+    angles = sorted(
+        (360.0 * i / _DIRECTIONS for i in range(_DIRECTIONS)),
+        key=lambda a: abs((a - prefer_deg + 180.0) % 360.0 - 180.0),
+    )
     for radius in _RADII:
         for angle in angles:
             c, s = math.cos(math.radians(angle)), math.sin(math.radians(angle))
@@ -556,8 +652,11 @@ def _obstacles(ax, renderer, labels) -> tuple[list, list]:
     paths, boxes = [], []
     for patch in ax.patches:
         path = patch.get_transform().transform_path(patch.get_path())
-        filled = bool(patch.get_hatch()) or (patch.get_facecolor()[3] > 0 and not isinstance(patch, FancyArrowPatch)
-                                             and len(path.vertices) <= 5)  # a small filled mark (the front ▶)
+        filled = bool(patch.get_hatch()) or (
+            patch.get_facecolor()[3] > 0
+            and not isinstance(patch, FancyArrowPatch)
+            and len(path.vertices) <= 5
+        )  # a small filled mark (the front ▶)
         paths += [(part, filled, 0.5 * patch.get_linewidth() * points) for part in _polylines(path)]
     for line in ax.lines:
         xy = line.get_xydata()
@@ -608,8 +707,11 @@ def _place_labels(ax) -> None:
         if best[0] and wrapped:  # no free place: try the label on two lines
             line = label.get_text()
             label.set_text(wrapped)
-            best = min(best + (line,), _best_position(label, prefer, renderer, obstacles) + (wrapped,),
-                       key=lambda choice: choice[0])
+            best = min(
+                best + (line,),
+                _best_position(label, prefer, renderer, obstacles) + (wrapped,),
+                key=lambda choice: choice[0],
+            )
             label.set_text(best[-1])
         _, offset, ha, va, box = best[:5]
         label.xyann = offset
@@ -617,8 +719,14 @@ def _place_labels(ax) -> None:
         label.set_verticalalignment(va)
         if math.hypot(*offset) > _LEADER_FROM:  # far from its anchor: a thin line says whose label it is
             start, end = _leader_segment(ax.transData.transform(label.xy), box)
-            ax.plot(*zip(*ax.transData.inverted().transform([start, end])), color=label.get_color(), lw=0.7,
-                    alpha=0.7, zorder=label.get_zorder() - 0.5, gid="leader")
+            ax.plot(
+                *zip(*ax.transData.inverted().transform([start, end])),
+                color=label.get_color(),
+                lw=0.7,
+                alpha=0.7,
+                zorder=label.get_zorder() - 0.5,
+                gid="leader",
+            )
             obstacles.add_leader(start, end)
         obstacles.boxes.append(box)
 
@@ -663,8 +771,9 @@ class _Obstacles:
 
         start, end = _leader_segment(anchor, box)
         leader = MplPath([start, end])
-        return (any(leader.intersects_bbox(Bbox([other[:2], other[2:]]), filled=False) for other in self.boxes)
-                or any(leader.intersects_path(other) for other in self.leaders))
+        return any(
+            leader.intersects_bbox(Bbox([other[:2], other[2:]]), filled=False) for other in self.boxes
+        ) or any(leader.intersects_path(other) for other in self.leaders)
 
     def best(self, candidates, anchor, far):
         """``(conflicts, index)`` of the first free box of ``candidates`` (an
@@ -677,7 +786,7 @@ class _Obstacles:
         import numpy as np
         from matplotlib.transforms import Bbox
 
-        x0, y0, x1, y1 = (candidates[:, i:i + 1] for i in range(4))
+        x0, y0, x1, y1 = (candidates[:, i : i + 1] for i in range(4))
         fx0, fy0, fx1, fy1 = self.frame
         outside = ~((fx0 <= x0) & (x1 <= fx1) & (fy0 <= y0) & (y1 <= fy1))[:, 0]
         b = np.array(self.boxes, dtype=float).reshape(-1, 4)
@@ -688,8 +797,10 @@ class _Obstacles:
         crossing = None
         for index in np.flatnonzero((~outside) & (hits == 0)):
             box = Bbox(candidates[index].reshape(2, 2))
-            if any(self.paths[k][0].intersects_bbox(box.padded(self.pads[k]), filled=self.paths[k][1])
-                   for k in np.flatnonzero(near[index])):
+            if any(
+                self.paths[k][0].intersects_bbox(box.padded(self.pads[k]), filled=self.paths[k][1])
+                for k in np.flatnonzero(near[index])
+            ):
                 continue
             if far[index] and self._leader_crosses(anchor, candidates[index]):
                 crossing = int(index) if crossing is None else crossing
@@ -716,9 +827,15 @@ def _best_position(label, prefer: float, renderer, obstacles: _Obstacles):
     half_w, half_h = 0.5 * centre.width, 0.5 * centre.height
     shift = {"left": 1.0, "right": -1.0, "center": 0.0, "bottom": 1.0, "top": -1.0}
     candidates = list(_candidates(prefer))
-    middles = np.array([(0.5 * (centre.x0 + centre.x1) + dx * points + shift[ha] * half_w,
-                         0.5 * (centre.y0 + centre.y1) + dy * points + shift[va] * half_h)
-                        for (dx, dy), ha, va in candidates])
+    middles = np.array(
+        [
+            (
+                0.5 * (centre.x0 + centre.x1) + dx * points + shift[ha] * half_w,
+                0.5 * (centre.y0 + centre.y1) + dy * points + shift[va] * half_h,
+            )
+            for (dx, dy), ha, va in candidates
+        ]
+    )
     size = np.array([half_w + pad, half_h + pad])
     boxes = np.hstack([middles - size, middles + size])
     far = np.array([math.hypot(*offset) > _LEADER_FROM for offset, _, _ in candidates])
@@ -732,8 +849,16 @@ def _rotated(centre, heading_deg, local):
     return [(centre[0] + c * x - s * y, centre[1] + s * x + c * y) for x, y in local]
 
 
-def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, title: str | None,
-          place_labels: bool = True):
+def _draw(
+    ax,
+    scene: Scene,
+    result: Any,
+    centre,
+    velocity_scale,
+    legend: bool,
+    title: str | None,
+    place_labels: bool = True,
+):
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
@@ -758,24 +883,49 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
             side = 1.0 if index == 1 else -1.0
             half = max(1.2 * size, 0.5 * body.outline[0] if body.outline else 0.0)
             depth = body.outline[1] if body.outline else 0.3 * size
-            corners = [_add(centre, _scale(t, -half)), _add(centre, _scale(t, half)),
-                       _add(_add(centre, _scale(t, half)), _scale(n, side * depth)),
-                       _add(_add(centre, _scale(t, -half)), _scale(n, side * depth))]
+            corners = [
+                _add(centre, _scale(t, -half)),
+                _add(centre, _scale(t, half)),
+                _add(_add(centre, _scale(t, half)), _scale(n, side * depth)),
+                _add(_add(centre, _scale(t, -half)), _scale(n, side * depth)),
+            ]
             canvas.polygon(corners, facecolor="0.9", edgecolor="0.2", hatch="///", lw=1.2, zorder=1)
-            canvas.label(_add(_add(centre, _scale(t, 0.75 * half)), _scale(n, side * depth)),
-                         body.name, _angle(_scale(n, side)), fontsize=9, color="0.2")
+            canvas.label(
+                _add(_add(centre, _scale(t, 0.75 * half)), _scale(n, side * depth)),
+                body.name,
+                _angle(_scale(n, side)),
+                fontsize=9,
+                color="0.2",
+            )
             handles.append(Patch(facecolor="0.9", edgecolor="0.2", hatch="///", label="fixed barrier"))
             continue
         fill, edge = _FILL[index], _EDGE[index]
         if body.outline:
             length, width, heading = body.outline
             half_l, half_w = 0.5 * length, 0.5 * width
-            canvas.polygon(_rotated(body.cg, heading, [(half_l, half_w), (-half_l, half_w),
-                                                       (-half_l, -half_w), (half_l, -half_w)]),
-                           facecolor=fill, edgecolor=edge, lw=1.5, alpha=0.9, zorder=1)
-            canvas.polygon(_rotated(body.cg, heading, [(0.9 * half_l, 0.0), (0.75 * half_l, 0.25 * half_w),
-                                                       (0.75 * half_l, -0.25 * half_w)]),
-                           facecolor=edge, edgecolor=edge, alpha=0.5, zorder=1)
+            canvas.polygon(
+                _rotated(
+                    body.cg,
+                    heading,
+                    [(half_l, half_w), (-half_l, half_w), (-half_l, -half_w), (half_l, -half_w)],
+                ),
+                facecolor=fill,
+                edgecolor=edge,
+                lw=1.5,
+                alpha=0.9,
+                zorder=1,
+            )
+            canvas.polygon(
+                _rotated(
+                    body.cg,
+                    heading,
+                    [(0.9 * half_l, 0.0), (0.75 * half_l, 0.25 * half_w), (0.75 * half_l, -0.25 * half_w)],
+                ),
+                facecolor=edge,
+                edgecolor=edge,
+                alpha=0.5,
+                zorder=1,
+            )
             reach = max(reach, half_l)
             handles.append(Patch(facecolor=fill, edgecolor=edge, label=f"{body.name} (outline, front ▶)"))
         else:
@@ -787,8 +937,13 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
 
     # crush surface, normal, impact centre
     half = 1.2 * reach
-    canvas.line(_add(centre, _scale(t, -half)), _add(centre, _scale(t, half)),
-                color=_COLOR["surface"], lw=2.5, zorder=3)
+    canvas.line(
+        _add(centre, _scale(t, -half)),
+        _add(centre, _scale(t, half)),
+        color=_COLOR["surface"],
+        lw=2.5,
+        zorder=3,
+    )
     tip = _add(centre, _scale(n, 0.6 * size))
     canvas.arrow(centre, tip, _COLOR["normal"], lw=1.5, zorder=6)
     canvas.label(tip, "n", _angle(n), fontsize=11, fontweight="bold")
@@ -807,14 +962,25 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
             tail = _add(body.cg, _scale(body.v0, k)) if body.v0 is not None else body.cg
             head = _add(tail, _scale(body.dv, k))
             canvas.arrow(tail, head, _COLOR["delta_v"], lw=2.0, ls="--", zorder=5)
-            canvas.label(_scale(_add(tail, head), 0.5), f"|ΔV| {_norm(body.dv):.3g}",
-                         _angle((-body.dv[1], body.dv[0])), fontsize=8, color=_COLOR["delta_v"])
+            canvas.label(
+                _scale(_add(tail, head), 0.5),
+                f"|ΔV| {_norm(body.dv):.3g}",
+                _angle((-body.dv[1], body.dv[0])),
+                fontsize=8,
+                color=_COLOR["delta_v"],
+            )
             drawn.add("delta_v")
         if body.force is not None and not body.fixed:
             tail = _sub(body.cg, _scale(body.force, 0.75 * size))
             canvas.arrow(tail, body.cg, _COLOR["pdof"], lw=1.8, ls="-.", zorder=6, scale=12)
-            canvas.label(tail, f"{body.name}: {_pdof_label(body)}", _angle(_scale(body.force, -1.0)),
-                         wrapped=f"{body.name}:\n{_pdof_label(body)}", fontsize=8, color=_COLOR["pdof"])
+            canvas.label(
+                tail,
+                f"{body.name}: {_pdof_label(body)}",
+                _angle(_scale(body.force, -1.0)),
+                wrapped=f"{body.name}:\n{_pdof_label(body)}",
+                fontsize=8,
+                color=_COLOR["pdof"],
+            )
             drawn.add("pdof")
         for rate, radius, ls, key in ((body.w0, 0.28, "--", "yaw_before"), (body.w1, 0.4, "-", "yaw_after")):
             if rate is None or wmax <= 0 or abs(rate) <= 1e-9 * wmax:
@@ -830,19 +996,22 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
         Line2D([], [], ls="none", marker="o", ms=7, mfc="white", mec="black", label="centre of gravity"),
         Line2D([], [], ls="none", marker="X", ms=9, mfc="black", mec="white", label="impact centre"),
         Line2D([], [], color=_COLOR["surface"], lw=2.5, label="crush surface (along t)"),
-        Line2D([], [], color=_COLOR["normal"], lw=1.5, marker=">", ms=5,
-               label="normal n (vehicle 1 → 2)"),
+        Line2D([], [], color=_COLOR["normal"], lw=1.5, marker=">", ms=5, label="normal n (vehicle 1 → 2)"),
     ]
     legend_lines = {
         "before": (dict(color=_COLOR["before"], lw=2.2), f"velocity before [{speed_unit}]"),
         "after": (dict(color=_COLOR["after"], lw=2.2), f"velocity after [{speed_unit}]"),
         "delta_v": (dict(color=_COLOR["delta_v"], lw=2.0, ls="--"), f"delta-V [{speed_unit}]"),
-        "pdof": (dict(color=_COLOR["pdof"], lw=1.8, ls="-."), "PDOF: impulse on vehicle\n[° clockwise from heading]"),
+        "pdof": (
+            dict(color=_COLOR["pdof"], lw=1.8, ls="-."),
+            "PDOF: impulse on vehicle\n[° clockwise from heading]",
+        ),
         "yaw_before": (dict(color=_COLOR["before"], lw=1.6, ls="--"), "yaw rate before [rad/s] (ccw +)"),
         "yaw_after": (dict(color=_COLOR["after"], lw=1.6), "yaw rate after [rad/s] (ccw +)"),
     }
-    handles += [Line2D([], [], label=label, **style) for key, (style, label) in legend_lines.items()
-                if key in drawn]
+    handles += [
+        Line2D([], [], label=label, **style) for key, (style, label) in legend_lines.items() if key in drawn
+    ]
 
     xlim, ylim = canvas.limits(0.15 * size)
     ax.set_xlim(*xlim)
@@ -857,9 +1026,18 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
         flags = int(_num(getattr(result, "flags", 0)) or 0)
         problems = [text for bit, text in _FLAG_SHORT.items() if flags & bit]
         if problems:
-            ax.text(0.01, 0.01, "flagged: " + "; ".join(problems), transform=ax.transAxes, fontsize=9,
-                    color="crimson", ha="left", va="bottom", zorder=10,
-                    bbox=dict(boxstyle="round,pad=0.25", fc="white", ec="crimson", alpha=0.85))
+            ax.text(
+                0.01,
+                0.01,
+                "flagged: " + "; ".join(problems),
+                transform=ax.transAxes,
+                fontsize=9,
+                color="crimson",
+                ha="left",
+                va="bottom",
+                zorder=10,
+                bbox=dict(boxstyle="round,pad=0.25", fc="white", ec="crimson", alpha=0.85),
+            )
     legend_title = f"arrows: 1 {length_unit} = {1.0 / k:.3g} {speed_unit}"
     if legend:
         _legend(ax, handles, legend_title)
@@ -870,12 +1048,25 @@ def _draw(ax, scene: Scene, result: Any, centre, velocity_scale, legend: bool, t
 
 def _legend(ax, handles, title: str):
     """The legend, outside the axes on the right."""
-    return ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8,
-                     title=title, title_fontsize=8, frameon=False)
+    return ax.legend(
+        handles=handles,
+        loc="upper left",
+        bbox_to_anchor=(1.01, 1.0),
+        fontsize=8,
+        title=title,
+        title_fontsize=8,
+        frameon=False,
+    )
 
 
-def _render(ax, scene_or_result: Any, *, scene: SceneLike | None = None,
-            velocity_scale: float | None = None, title: str | None = None):
+def _render(
+    ax,
+    scene_or_result: Any,
+    *,
+    scene: SceneLike | None = None,
+    velocity_scale: float | None = None,
+    title: str | None = None,
+):
     """Draw like :func:`scene` but without the legend and with the labels at
     their anchors; return ``(handles, legend title)`` for :func:`_legend` (the
     explorer adds the legend only when it changes, and calls :func:`_place_labels`
@@ -903,14 +1094,23 @@ def _pdof_label(body: _Body) -> str:
 def _title(scene: Scene, result: Any) -> str:
     impact = scene.impact
     name = scene.source.name if scene.source is not None else "scene"
-    mu = ("μ = μ_c" if impact.critical else f"slip = {impact.slip:g}"
-          if impact.impulse_ratio is None else f"μ = {float(impact.impulse_ratio):g}")
+    mu = (
+        "μ = μ_c"
+        if impact.critical
+        else f"slip = {impact.slip:g}"
+        if impact.impulse_ratio is None
+        else f"μ = {float(impact.impulse_ratio):g}"
+    )
     em = f", e_m = {impact.moment_restitution:g}" if scene.uses_yaw else ""
-    head = (f"{name}: {scene.model} model, {scene.units}; Γ = {impact.normal_angle:g}°, "
-            f"e = {impact.restitution:g}, {mu}{em}")
+    head = (
+        f"{name}: {scene.model} model, {scene.units}; Γ = {impact.normal_angle:g}°, "
+        f"e = {impact.restitution:g}, {mu}{em}"
+    )
     if getattr(result, "kind", None) == "reconstruct":
-        head = (f"{name}: reconstruction, {scene.units}; Γ = {impact.normal_angle:g}°, implied e = {result.e:.3g}, "
-                f"e_m = {result.e_m:.3g}")
+        head = (
+            f"{name}: reconstruction, {scene.units}; Γ = {impact.normal_angle:g}°, implied e = {result.e:.3g}, "
+            f"e_m = {result.e_m:.3g}"
+        )
     if result is None:
         return head
     energy = UNIT_LABELS[scene.units]["energy"]

@@ -50,8 +50,11 @@ def crash3_figure(result: Crash3Result, scene: Any):
     options = result.options
     fixed = [vehicle.name for vehicle, table in zip(result.vehicles, tables) if table is None]
     against = f", against {', '.join(fixed)} (fixed, no crush)" if fixed else ""
-    fig.suptitle(f"{name}: CRASH3, {result.units}{against}\ne = {options.restitution:g}, crush energy "
-                 f"{options.energy}, {options.correction} correction", fontsize=11)
+    fig.suptitle(
+        f"{name}: CRASH3, {result.units}{against}\ne = {options.restitution:g}, crush energy "
+        f"{options.energy}, {options.correction} correction",
+        fontsize=11,
+    )
     return fig
 
 
@@ -68,8 +71,15 @@ def _panel(ax, vehicle, table, units: str) -> None:
     width, depths = table.width, table.depths
     xs = [-0.5 * width + width * i / (len(depths) - 1) for i in range(len(depths))]
     deepest = max(depths)
-    ax.fill([*xs, xs[-1], xs[0]], [*(-c for c in depths), 0.0, 0.0], facecolor=_FILL, edgecolor=_EDGE, lw=1.5,
-            gid="crush", label="crushed region")
+    ax.fill(
+        [*xs, xs[-1], xs[0]],
+        [*(-c for c in depths), 0.0, 0.0],
+        facecolor=_FILL,
+        edgecolor=_EDGE,
+        lw=1.5,
+        gid="crush",
+        label="crushed region",
+    )
     ax.plot(xs, [-c for c in depths], ls="none", marker="o", ms=5, color=_EDGE, gid="profile")
     ax.plot([-0.5 * width, 0.5 * width], [0.0, 0.0], color="black", lw=2.0, gid="face")
     gap = 0.03 * width  # between a point and its depth
@@ -80,11 +90,23 @@ def _panel(ax, vehicle, table, units: str) -> None:
     direction = (math.sin(alpha), -math.cos(alpha))
     arrow = 0.25 * width
     tail = (-direction[0] * arrow, -direction[1] * arrow)
-    ax.annotate("", (0.0, 0.0), tail, arrowprops=dict(arrowstyle="-|>", color=_PDOF, lw=2.2, mutation_scale=16,
-                                                      shrinkA=0, shrinkB=0), gid="pdof")
+    ax.annotate(
+        "",
+        (0.0, 0.0),
+        tail,
+        arrowprops=dict(arrowstyle="-|>", color=_PDOF, lw=2.2, mutation_scale=16, shrinkA=0, shrinkB=0),
+        gid="pdof",
+    )
     side = "left" if direction[0] <= 0 else "right"  # the label beside the tail, away from the arrow
-    ax.text(tail[0] + (0.03 if side == "left" else -0.03) * width, tail[1], f"PDOF {table.pdof:g}°",
-            ha=side, va="center", fontsize=9, color=_PDOF)
+    ax.text(
+        tail[0] + (0.03 if side == "left" else -0.03) * width,
+        tail[1],
+        f"PDOF {table.pdof:g}°",
+        ha=side,
+        va="center",
+        fontsize=9,
+        color=_PDOF,
+    )
     ax.text(0.5 * width, 0.02 * width, f"L = {width:g} {length}", ha="right", va="bottom", fontsize=8)
     ax.set_aspect("equal", adjustable="box")  # true shape: depths against width
     top = max(tail[1], 0.0) + 0.1 * width
@@ -94,6 +116,9 @@ def _panel(ax, vehicle, table, units: str) -> None:
     ax.set_xlabel(f"across the damaged face [{length}]")
     ax.set_ylabel(f"crush depth [{length}]")
     labels = UNIT_LABELS[units]
-    ax.set_title(f"{vehicle.name}: crush energy {vehicle.crush_energy:.4g} {labels['energy']}\n"
-                 f"|ΔV| {vehicle.delta_v_magnitude:.3g} {labels['velocity']}", fontsize=10)
+    ax.set_title(
+        f"{vehicle.name}: crush energy {vehicle.crush_energy:.4g} {labels['energy']}\n"
+        f"|ΔV| {vehicle.delta_v_magnitude:.3g} {labels['velocity']}",
+        fontsize=10,
+    )
     ax.grid(True, lw=0.4, alpha=0.5)

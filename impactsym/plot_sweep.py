@@ -20,12 +20,36 @@ from ._util import require
 from .codes import FLAG_ENERGY_CREATED, FLAG_MU_BEYOND_CRITICAL, FLAG_TENSILE_IMPULSE
 from .result import UNIT_LABELS
 
-__all__ = ["sweep", "save_sweep", "SWEEP_OUTPUTS", "IMPOSSIBLE_FLAGS", "IMPOSSIBLE_LABEL",
-           "NOT_SOLVED_LABEL", "MU_C_LABEL"]
+__all__ = [
+    "sweep",
+    "save_sweep",
+    "SWEEP_OUTPUTS",
+    "IMPOSSIBLE_FLAGS",
+    "IMPOSSIBLE_LABEL",
+    "NOT_SOLVED_LABEL",
+    "MU_C_LABEL",
+]
 
 #: Output columns of a sweep frame (as ``solve_batch`` names them); ``mu`` is also an input.
-SWEEP_OUTPUTS = ("V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M", "mu", "mu_c",
-                 "dV1", "dV2", "TL", "TLn", "TLt", "TLm")
+SWEEP_OUTPUTS = (
+    "V1x",
+    "V1y",
+    "W1",
+    "V2x",
+    "V2y",
+    "W2",
+    "Pn",
+    "Pt",
+    "M",
+    "mu",
+    "mu_c",
+    "dV1",
+    "dV2",
+    "TL",
+    "TLn",
+    "TLt",
+    "TLm",
+)
 #: Flag bits that make a solved row physically impossible on a sweep plot.
 IMPOSSIBLE_FLAGS = FLAG_ENERGY_CREATED | FLAG_TENSILE_IMPULSE | FLAG_MU_BEYOND_CRITICAL
 IMPOSSIBLE_LABEL = "physically impossible (energy created, tensile impulse or μ beyond μ_c)"
@@ -39,13 +63,20 @@ _SYSTEM_UNITS = {
 }
 _FIXED_UNITS = {"deg": "°", "rad": "rad", "yaw_rate": "rad/s"}  # the same in both systems
 _QUANTITIES = {
-    "e": ("restitution e", None), "mu": ("impulse ratio μ", None), "e_m": ("moment restitution e_m", None),
-    "normal_angle": ("normal angle Γ", "deg"), "gamma": ("normal angle Γ", "rad"), "slip": ("slip", None),
+    "e": ("restitution e", None),
+    "mu": ("impulse ratio μ", None),
+    "e_m": ("moment restitution e_m", None),
+    "normal_angle": ("normal angle Γ", "deg"),
+    "gamma": ("normal angle Γ", "rad"),
+    "slip": ("slip", None),
     "mu_c": ("critical impulse ratio μ_c", None),
-    "Pn": ("normal impulse Pn", "impulse"), "Pt": ("tangential impulse Pt", "impulse"),
+    "Pn": ("normal impulse Pn", "impulse"),
+    "Pt": ("tangential impulse Pt", "impulse"),
     "M": ("moment impulse M", "moment"),
-    "TL": ("energy loss TL", "energy"), "TLn": ("normal energy loss TLn", "energy"),
-    "TLt": ("tangential energy loss TLt", "energy"), "TLm": ("moment energy loss TLm", "energy"),
+    "TL": ("energy loss TL", "energy"),
+    "TLn": ("normal energy loss TLn", "energy"),
+    "TLt": ("tangential energy loss TLt", "energy"),
+    "TLm": ("moment energy loss TLm", "energy"),
     **{f"m{i}": (f"mass m{i}", "mass") for i in "12"},
     **{f"I{i}": (f"yaw inertia I{i}", "inertia") for i in "12"},
     **{f"w{i}": (f"initial yaw rate w{i}", "yaw_rate") for i in "12"},
@@ -110,8 +141,9 @@ def sweep(df, x: str, y: str | None = None, color=None, ax=None, units: str | No
     return ax
 
 
-def save_sweep(df, path: str | Path, x: str, y: str | None = None, color=None,
-               units: str | None = None) -> Path:
+def save_sweep(
+    df, path: str | Path, x: str, y: str | None = None, color=None, units: str | None = None
+) -> Path:
     """Draw like :func:`sweep` on a fresh Agg figure (no pyplot, no display
     needed) and write it to ``path`` (PNG for ``.png``; the format follows the
     suffix as in :func:`save_plot`). Returns the path."""
@@ -131,8 +163,9 @@ def _color_columns(color, two_d: bool) -> list[str]:
     """The drawn output columns: ``TL`` by default; a heatmap shows one."""
     columns = ["TL"] if color is None else [color] if isinstance(color, str) else list(color)
     if not columns or (two_d and len(columns) != 1):
-        raise ValueError(f"color: a {'heatmap shows one column' if two_d else 'line plot needs a column'}, "
-                         f"got {color!r}")
+        raise ValueError(
+            f"color: a {'heatmap shows one column' if two_d else 'line plot needs a column'}, got {color!r}"
+        )
     return columns
 
 
@@ -147,11 +180,16 @@ def _check_sweep(df, x: str, y: str | None, columns: list[str], units: str | Non
     for name in axes + columns:
         if name not in names:
             raise ValueError(f"{name}: no such column in the sweep (columns: {', '.join(map(str, names))})")
-    extra = [name for name in _parameters(names) if name not in axes and name not in columns
-             and len(np.unique(np.asarray(df[name]))) > 1]
+    extra = [
+        name
+        for name in _parameters(names)
+        if name not in axes and name not in columns and len(np.unique(np.asarray(df[name]))) > 1
+    ]
     if extra:
-        raise ValueError(f"the sweep also varies {', '.join(extra)}, which the plot's axes do not use; "
-                         f"filter it to one value each first (e.g. df[df[{extra[0]!r}] == value])")
+        raise ValueError(
+            f"the sweep also varies {', '.join(extra)}, which the plot's axes do not use; "
+            f"filter it to one value each first (e.g. df[df[{extra[0]!r}] == value])"
+        )
 
 
 def _parameters(names: list[str]) -> list[str]:
@@ -207,8 +245,10 @@ def _grid(df, x: str, y: str):
     counts = np.zeros((len(ys), len(xs)), dtype=np.int64)
     np.add.at(counts, (iy, ix), 1)
     if (counts != 1).any():
-        raise ValueError(f"{x} × {y}: not a full grid ({len(ix)} rows for {len(xs)} × {len(ys)} values, "
-                         f"{int((counts == 0).sum())} missing, {int((counts > 1).sum())} repeated)")
+        raise ValueError(
+            f"{x} × {y}: not a full grid ({len(ix)} rows for {len(xs)} × {len(ys)} values, "
+            f"{int((counts == 0).sum())} missing, {int((counts > 1).sum())} repeated)"
+        )
     return xs, ys, iy, ix
 
 
@@ -242,9 +282,19 @@ def _cell_mask(ax, mask: np.ndarray, xedges, yedges, gid: str, label: str) -> No
     rectangles (runs along x merged), styled by ``_MASK_STYLE[gid]``."""
     from matplotlib.collections import PolyCollection
 
-    boxes = [[(xedges[a], yedges[j]), (xedges[b], yedges[j]), (xedges[b], yedges[j + 1]), (xedges[a], yedges[j + 1])]
-             for j, row in enumerate(mask) for a, b in _runs(row)]
-    ax.add_collection(PolyCollection(boxes, gid=gid, label=label, zorder=2, **_MASK_STYLE[gid]), autolim=False)
+    boxes = [
+        [
+            (xedges[a], yedges[j]),
+            (xedges[b], yedges[j]),
+            (xedges[b], yedges[j + 1]),
+            (xedges[a], yedges[j + 1]),
+        ]
+        for j, row in enumerate(mask)
+        for a, b in _runs(row)
+    ]
+    ax.add_collection(
+        PolyCollection(boxes, gid=gid, label=label, zorder=2, **_MASK_STYLE[gid]), autolim=False
+    )
 
 
 def _finite_mean(values: np.ndarray, axis: int) -> np.ndarray:
@@ -282,7 +332,10 @@ def _sweep_map(ax, df, x: str, y: str, column: str, units: str | None) -> None:
     mesh = ax.pcolormesh(xedges, yedges, np.ma.masked_invalid(values), cmap="viridis", gid="values", zorder=1)
     ax.figure.colorbar(mesh, ax=ax, label=_label(column, units))
     handles = []
-    for gid, label, rows in (("impossible", IMPOSSIBLE_LABEL, impossible), ("not_solved", NOT_SOLVED_LABEL, ~solved)):
+    for gid, label, rows in (
+        ("impossible", IMPOSSIBLE_LABEL, impossible),
+        ("not_solved", NOT_SOLVED_LABEL, ~solved),
+    ):
         if rows.any():
             _cell_mask(ax, _on_grid(rows, iy, ix, shape, fill=False), xedges, yedges, gid, label)
             handles.append(Patch(label=label, **_MASK_STYLE[gid]))
@@ -299,26 +352,46 @@ def _sweep_line(ax, df, x: str, columns: list[str], units: str | None) -> None:
     """The 1-D line plot of :func:`sweep`."""
     xs, index = _axis_values(df, x)
     if len(xs) != len(index):
-        raise ValueError(f"{x}: repeated values ({len(index)} rows for {len(xs)} values); "
-                         "filter the other varied parameters first")
+        raise ValueError(
+            f"{x}: repeated values ({len(index)} rows for {len(xs)} values); "
+            "filter the other varied parameters first"
+        )
     solved_rows, impossible_rows = _status_flags(df, len(index))
     order = np.argsort(index)
     solved, impossible = solved_rows[order], impossible_rows[order]
     handles = []
     for column in columns:
         values = np.asarray(df[column], dtype=np.float64)[order]
-        handles += ax.plot(xs, values, marker=".", lw=1.8, gid="values", label=_label(column, units), zorder=3)
-        crosses = ax.plot(xs[impossible], values[impossible], ls="none", marker="x", ms=8, mew=2.0,
-                          color="crimson", gid="impossible", label=IMPOSSIBLE_LABEL, zorder=4)
+        handles += ax.plot(
+            xs, values, marker=".", lw=1.8, gid="values", label=_label(column, units), zorder=3
+        )
+        crosses = ax.plot(
+            xs[impossible],
+            values[impossible],
+            ls="none",
+            marker="x",
+            ms=8,
+            mew=2.0,
+            color="crimson",
+            gid="impossible",
+            label=IMPOSSIBLE_LABEL,
+            zorder=4,
+        )
     handles += crosses if impossible.any() else []
     edges = _edges(xs)
-    spans = [ax.axvspan(edges[a], edges[b], color="0.3", alpha=0.35, lw=0, gid="not_solved", label=NOT_SOLVED_LABEL)
-             for a, b in _runs(~solved)]
+    spans = [
+        ax.axvspan(
+            edges[a], edges[b], color="0.3", alpha=0.35, lw=0, gid="not_solved", label=NOT_SOLVED_LABEL
+        )
+        for a, b in _runs(~solved)
+    ]
     handles += spans[:1]
     if x == "mu" and "mu_c" in df:
         mu_c = _finite_mean(np.asarray(df["mu_c"], dtype=np.float64)[solved_rows], axis=0)
         if np.isfinite(mu_c):
-            handles.append(ax.axvline(float(mu_c), color="crimson", lw=1.5, ls="--", gid="mu_c", label=MU_C_LABEL))
+            handles.append(
+                ax.axvline(float(mu_c), color="crimson", lw=1.5, ls="--", gid="mu_c", label=MU_C_LABEL)
+            )
     ylabel = _lines_label(columns, units)
     _finish(ax, _label(x, units), ylabel, ylabel, solved, impossible, handles)
 
@@ -329,9 +402,13 @@ def _finish(ax, xlabel: str, ylabel: str, quantity: str, solved, impossible, han
     as :func:`sweep` and :func:`save_sweep` use, makes room for it)."""
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
-    ax.set_title(f"{quantity}\nphysically impossible: {int(impossible.sum())} of {int(solved.sum())} solved "
-                 f"points; not solved: {int((~solved).sum())}", fontsize=10)
+    ax.set_title(
+        f"{quantity}\nphysically impossible: {int(impossible.sum())} of {int(solved.sum())} solved "
+        f"points; not solved: {int((~solved).sum())}",
+        fontsize=10,
+    )
     ax.grid(True, lw=0.4, alpha=0.5)
     if handles:
-        ax.figure.legend(handles=handles, loc="outside lower center", ncols=min(2, len(handles)), fontsize=8,
-                         frameon=False)
+        ax.figure.legend(
+            handles=handles, loc="outside lower center", ncols=min(2, len(handles)), fontsize=8, frameon=False
+        )

@@ -55,18 +55,35 @@ from .uncertainty_commands import COMMANDS, COMPLEX_STEP, RECONSTRUCT, Command, 
 from .uncertainty_inputs import Input, cholesky, correlation_matrix
 from .uncertainty_result import KEEP, Stats, Uncertainty
 
-STATUS_NAMES = {getattr(_codes, n): n[len("STATUS_"):] for n in dir(_codes) if n.startswith("STATUS_")}
-FLAG_NAMES = {n[len("FLAG_"):]: getattr(_codes, n) for n in dir(_codes) if n.startswith("FLAG_")}
+STATUS_NAMES = {getattr(_codes, n): n[len("STATUS_") :] for n in dir(_codes) if n.startswith("STATUS_")}
+FLAG_NAMES = {n[len("FLAG_") :]: getattr(_codes, n) for n in dir(_codes) if n.startswith("FLAG_")}
 
-__all__ = ["BLOCK", "COMMANDS", "KEEP", "RECONSTRUCT", "Command", "Input", "Source",
-           "Uncertainty", "command_for", "propagate", "uncertainty"]
+__all__ = [
+    "BLOCK",
+    "COMMANDS",
+    "KEEP",
+    "RECONSTRUCT",
+    "Command",
+    "Input",
+    "Source",
+    "Uncertainty",
+    "command_for",
+    "propagate",
+    "uncertainty",
+]
 
 #: Flags that make a draw physically impossible (ill-conditioned headings only warn).
-REJECTING_FLAGS = ("ENERGY_CREATED", "TENSILE_IMPULSE", "MU_BEYOND_CRITICAL",
-                   "E_OUT_OF_RANGE", "NEGATIVE_SPEED")
+REJECTING_FLAGS = (
+    "ENERGY_CREATED",
+    "TENSILE_IMPULSE",
+    "MU_BEYOND_CRITICAL",
+    "E_OUT_OF_RANGE",
+    "NEGATIVE_SPEED",
+)
 
 
 # --------------------------------------------------------------------------- a source of columns
+
 
 @dataclass(frozen=True)
 class Source:
@@ -84,26 +101,41 @@ class Source:
 
 # --------------------------------------------------------------------------- propagation
 
-def propagate(source: Source, draws: int = 10_000, seed: int | None = None, sobol: bool = False,
-              chunk_size: int = CHUNK_SIZE) -> Uncertainty:
+
+def propagate(
+    source: Source,
+    draws: int = 10_000,
+    seed: int | None = None,
+    sobol: bool = False,
+    chunk_size: int = CHUNK_SIZE,
+) -> Uncertainty:
     """Monte Carlo and first-order propagation of `source`'s uncertain inputs
     (see the module docstring). `draws` Monte Carlo draws from `seed`
     (None: fresh entropy, reported as `Uncertainty.seed`)."""
     if not isinstance(draws, int) or isinstance(draws, bool) or draws < 2:
         raise ValueError(f"draws: must be an integer >= 2, got {draws!r}")
     if not source.inputs:
-        raise ValueError("the scene has no uncertain inputs: give a leaf as "
-                         '{"normal": [mean, sd]}, {"uniform": [low, high]} or '
-                         '{"triangular": [low, mode, high]}')
+        raise ValueError(
+            "the scene has no uncertain inputs: give a leaf as "
+            '{"normal": [mean, sd]}, {"uniform": [low, high]} or '
+            '{"triangular": [low, mode, high]}'
+        )
     command = source.command
     nominal = _nominal(source)
     corr = correlation_matrix(source.inputs, source.correlations)
     factor = cholesky(corr)
     entropy = np.random.SeedSequence(seed).entropy
-    plan = SamplePlan(model="", units="", outputs=None, constants={},
-                      names=tuple(x.path for x in source.inputs), kernels=(),
-                      dists=(("normal", (0.0, 1.0)),) * len(source.inputs),
-                      entropy=entropy, rows=draws)
+    plan = SamplePlan(
+        model="",
+        units="",
+        outputs=None,
+        constants={},
+        names=tuple(x.path for x in source.inputs),
+        kernels=(),
+        dists=(("normal", (0.0, 1.0)),) * len(source.inputs),
+        entropy=entropy,
+        rows=draws,
+    )
     stats = {path: Stats(value) for path, value in nominal["outputs"].items()}
     rejected: dict[str, int] = {}
     accepted, kept, kept_rows = 0, [], 0
@@ -118,21 +150,40 @@ def propagate(source: Source, draws: int = 10_000, seed: int | None = None, sobo
             s.add(np.asarray(values[path], dtype=np.float64)[ok])
         if kept_rows < KEEP:
             kept_rows += int(ok.sum())
-            kept.append({**{p: v[ok] for p, v in overrides.items()},
-                         **{p: np.broadcast_to(v, ok.shape)[ok] for p, v in values.items()}})
+            kept.append(
+                {
+                    **{p: v[ok] for p, v in overrides.items()},
+                    **{p: np.broadcast_to(v, ok.shape)[ok] for p, v in values.items()},
+                }
+            )
     gradient = _gradients(source, nominal)
     cov = corr * np.outer([x.sd for x in source.inputs], [x.sd for x in source.inputs])
     outputs, budget = {}, {}
     for path, s in stats.items():
         p5, p50, p95 = s.percentiles()
         sd_lin, shares = _linear(gradient.get(path), cov, source.inputs)
-        outputs[path] = {"nominal": nominal["outputs"][path], "mean": s.mean, "sd": s.sd,
-                         "p5": p5, "p50": p50, "p95": p95, "sd_linear": sd_lin}
+        outputs[path] = {
+            "nominal": nominal["outputs"][path],
+            "mean": s.mean,
+            "sd": s.sd,
+            "p5": p5,
+            "p50": p50,
+            "p95": p95,
+            "sd_linear": sd_lin,
+        }
         budget[path] = shares
-    result = Uncertainty(command.name, draws, accepted, rejected,
-                         tuple(x.path for x in source.inputs), outputs, budget,
-                         kept, _notes(nominal["flags"], accepted, draws, rejected),
-                         seed=int(entropy) if seed is None else seed)
+    result = Uncertainty(
+        command.name,
+        draws,
+        accepted,
+        rejected,
+        tuple(x.path for x in source.inputs),
+        outputs,
+        budget,
+        kept,
+        _notes(nominal["flags"], accepted, draws, rejected),
+        seed=int(entropy) if seed is None else seed,
+    )
     if sobol:
         result.sobol = sobol_indices(source, draws, seed, stats)
     return result
@@ -143,8 +194,10 @@ def _run_chunk(source: Source, overrides: dict, rejected: dict):
     columns, reason = source.columns(overrides)
     outs, status, flags = source.command.run(columns)
     n = status.shape[0]
-    values = {path: np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
-              for path, v in source.command.outputs(columns, outs).items()}
+    values = {
+        path: np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
+        for path, v in source.command.outputs(columns, outs).items()
+    }
     ok = np.ones(n, dtype=bool)
     reason = np.broadcast_to(np.asarray(reason, dtype=object), (n,))
     bad_leaf = reason != ""
@@ -174,21 +227,29 @@ def _nominal(source: Source) -> dict:
     columns, reason = source.columns(overrides)
     outs, status, flags = source.command.run(columns)
     if int(np.asarray(status)[0]) != 0 or np.asarray(reason)[0] != "":
-        raise ValueError("the nominal scene cannot be solved: "
-                         + (str(np.asarray(reason)[0]) or STATUS_NAMES[int(status[0])].lower()))
+        raise ValueError(
+            "the nominal scene cannot be solved: "
+            + (str(np.asarray(reason)[0]) or STATUS_NAMES[int(status[0])].lower())
+        )
     values = source.command.outputs(columns, outs)
-    return {"columns": _row(columns, 0), "outputs": {p: float(np.ravel(v)[0]) for p, v in values.items()},
-            "flags": int(flags[0])}
+    return {
+        "columns": _row(columns, 0),
+        "outputs": {p: float(np.ravel(v)[0]) for p, v in values.items()},
+        "flags": int(flags[0]),
+    }
 
 
 def _row(columns: Mapping, i: int) -> dict:
     """Row i of columns as scalars (strings such as mu = "critical" kept;
     CRASH3's per-vehicle crush tables row by row too)."""
+
     def at(v):
         return v if isinstance(v, str) or np.ndim(v) == 0 else float(np.asarray(v)[i])
 
-    return {k: ([None if t is None else {a: at(b) for a, b in t.items()} for t in v]
-                if k == "crush" else at(v)) for k, v in columns.items()}
+    return {
+        k: ([None if t is None else {a: at(b) for a, b in t.items()} for t in v] if k == "crush" else at(v))
+        for k, v in columns.items()
+    }
 
 
 def _flat(columns: Mapping) -> dict:
@@ -206,16 +267,19 @@ def _notes(flags: int, accepted: int, draws: int, rejected: dict) -> list[str]:
     for name in REJECTING_FLAGS:
         if flags & FLAG_NAMES[name]:
             what = name.lower().replace("_", " ")
-            verdict = ("the flag is measurement noise" if share >= 0.5 else
-                       "the flag is robust: most draws are impossible too")
-            notes.append(f"{what} at the nominal values; {share:.0%} of draws are physical "
-                         f"({verdict})")
+            verdict = (
+                "the flag is measurement noise"
+                if share >= 0.5
+                else "the flag is robust: most draws are impossible too"
+            )
+            notes.append(f"{what} at the nominal values; {share:.0%} of draws are physical ({verdict})")
     if accepted == 0:
         notes.append("no draw is physical: the statistics are undefined")
     return notes
 
 
 # --------------------------------------------------------------------------- linear method
+
 
 def _gradients(source: Source, nominal: dict) -> dict:
     """Output path → gradient (one entry per input) at the nominal scene;
@@ -259,12 +323,11 @@ def _column_derivatives(source: Source, base: dict) -> list[dict]:
     h = 1e-3 of the input's sd, all in one call of the column map."""
     x0 = np.array([x.nominal for x in source.inputs])
     k = len(x0)
-    h = np.array([1e-3 * x.sd if x.sd > 0 else 1e-6 * max(abs(x.nominal), 1.0)
-                  for x in source.inputs])
+    h = np.array([1e-3 * x.sd if x.sd > 0 else 1e-6 * max(abs(x.nominal), 1.0) for x in source.inputs])
     offsets = np.array([1.0, -1.0, 0.5, -0.5])
     grid = np.repeat(x0[:, None], 4 * k, axis=1)
     for j in range(k):
-        grid[j, 4 * j:4 * j + 4] += offsets * h[j]
+        grid[j, 4 * j : 4 * j + 4] += offsets * h[j]
     columns, _reason = source.columns({x.path: grid[i] for i, x in enumerate(source.inputs)})
     out = []
     for j in range(k):
@@ -272,7 +335,7 @@ def _column_derivatives(source: Source, base: dict) -> list[dict]:
         for name, col in _flat(columns).items():
             if isinstance(col, str) or np.ndim(col) == 0:
                 continue
-            f = np.asarray(col, dtype=np.float64)[4 * j:4 * j + 4]
+            f = np.asarray(col, dtype=np.float64)[4 * j : 4 * j + 4]
             d_h = (f[0] - f[1]) / (2 * h[j])
             d_half = (f[2] - f[3]) / h[j]
             d = (4 * d_half - d_h) / 3
@@ -296,6 +359,7 @@ def _linear(gradient, cov: np.ndarray, inputs) -> tuple[float, dict]:
 
 # --------------------------------------------------------------------------- Sobol
 
+
 def sobol_indices(source: Source, draws: int, seed, stats: dict) -> dict:
     """First-order and total Sobol indices per output (SALib, Saltelli's
     scheme, independent inputs), from about `draws` model runs."""
@@ -318,35 +382,47 @@ def sobol_indices(source: Source, draws: int, seed, stats: dict) -> dict:
             continue
         y[~ok] = y[ok].mean()
         si = analyze.analyze(problem, y, calc_second_order=False, seed=seed)
-        result[path] = {"S1": dict(zip(problem["names"], map(float, si["S1"]))),
-                        "ST": dict(zip(problem["names"], map(float, si["ST"]))),
-                        "replaced": float(1 - ok.mean())}
+        result[path] = {
+            "S1": dict(zip(problem["names"], map(float, si["S1"]))),
+            "ST": dict(zip(problem["names"], map(float, si["ST"]))),
+            "replaced": float(1 - ok.mean()),
+        }
     return result
 
 
 # --------------------------------------------------------------------------- scenes
 
-def uncertainty(scene, command: str = "solve", draws: int = 10_000, seed: int | None = None,
-                sobol: bool = False, restitution: float = 0.0, energy: str | None = None,
-                correction: str | None = None) -> Uncertainty:
+
+def uncertainty(
+    scene,
+    command: str = "solve",
+    draws: int = 10_000,
+    seed: int | None = None,
+    sobol: bool = False,
+    restitution: float = 0.0,
+    energy: str | None = None,
+    correction: str | None = None,
+) -> Uncertainty:
     """Uncertainty of ``command``'s answers for a scene whose leaves carry
     distributions (see the module docstring and conventions.md, Uncertainty).
     ``restitution``, ``energy``, ``correction``: CRASH3's options (crash3
     only; the uncertainty of CRASH3 supports its default energy treatment,
     dissipated, and the 1 + tan²α correction)."""
     if energy not in (None, "dissipated") or correction not in (None, "crash3"):
-        raise ValueError("--uncertainty of crash3 supports energy 'dissipated' and correction "
-                         f"'crash3' only, got energy {energy!r}, correction {correction!r}")
-    return propagate(scene_source(scene, command, restitution), draws=draws, seed=seed,
-                     sobol=sobol)
+        raise ValueError(
+            "--uncertainty of crash3 supports energy 'dissipated' and correction "
+            f"'crash3' only, got energy {energy!r}, correction {correction!r}"
+        )
+    return propagate(scene_source(scene, command, restitution), draws=draws, seed=seed, sobol=sobol)
 
 
 def scene_source(scene, command: str, restitution: float = 0.0) -> Source:
     """The Source of a scene (path, mapping or Scene) for a command."""
     from .scene import load_scene, scene_columns
 
-    kind = {"solve": "forward", "invert": "inverse", "reconstruct": "reconstruct",
-            "crash3": "crash3"}.get(command)
+    kind = {"solve": "forward", "invert": "inverse", "reconstruct": "reconstruct", "crash3": "crash3"}.get(
+        command
+    )
     if kind is None:
         raise ValueError(f"command: unknown command {command!r} (use one of {', '.join(COMMANDS)})")
     parsed = load_scene(scene, kind=kind)
@@ -356,5 +432,9 @@ def scene_source(scene, command: str, restitution: float = 0.0) -> Source:
         sc = scene_columns(parsed, overrides)
         return sc.columns, sc.reason
 
-    return Source(command_for(command, parsed.model, parsed.units, restitution), inputs, columns,
-                  tuple(getattr(parsed, "correlations", ())))
+    return Source(
+        command_for(command, parsed.model, parsed.units, restitution),
+        inputs,
+        columns,
+        tuple(getattr(parsed, "correlations", ())),
+    )

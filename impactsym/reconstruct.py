@@ -22,8 +22,28 @@ from .result import UNIT_LABELS, json_number, road_speed_rows, table_cell, witho
 from .scene import Scene, SceneError, load_scene
 from .single import overflow_error
 
-OUTPUTS = ("s1", "s2", "v1x", "v1y", "v2x", "v2y", "Pn", "Pt", "M", "M_residual",
-           "e", "mu", "e_m", "mu_c", "TL", "TLn", "TLt", "TLm", "pdof1", "pdof2")
+OUTPUTS = (
+    "s1",
+    "s2",
+    "v1x",
+    "v1y",
+    "v2x",
+    "v2y",
+    "Pn",
+    "Pt",
+    "M",
+    "M_residual",
+    "e",
+    "mu",
+    "e_m",
+    "mu_c",
+    "TL",
+    "TLn",
+    "TLt",
+    "TLm",
+    "pdof1",
+    "pdof2",
+)
 
 
 def reconstruct_batch(columns):
@@ -54,11 +74,15 @@ class ReconstructedVehicle:
     pdof_clock: int
 
     def to_json_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "speed": json_number(self.speed),
-                "velocity": [json_number(v) for v in self.velocity],
-                "delta_v": [json_number(v) for v in self.delta_v],
-                "delta_v_magnitude": json_number(self.delta_v_magnitude),
-                "pdof_deg": json_number(self.pdof_deg), "pdof_clock": self.pdof_clock}
+        return {
+            "name": self.name,
+            "speed": json_number(self.speed),
+            "velocity": [json_number(v) for v in self.velocity],
+            "delta_v": [json_number(v) for v in self.delta_v],
+            "delta_v_magnitude": json_number(self.delta_v_magnitude),
+            "pdof_deg": json_number(self.pdof_deg),
+            "pdof_clock": self.pdof_clock,
+        }
 
 
 @dataclass(frozen=True)
@@ -90,15 +114,22 @@ class Reconstruction:
         return {
             "units": self.units,
             "vehicles": [v.to_json_dict() for v in self.vehicles],
-            "impulse": {"normal": json_number(self.Pn), "tangential": json_number(self.Pt),
-                        "moment": json_number(self.M)},
+            "impulse": {
+                "normal": json_number(self.Pn),
+                "tangential": json_number(self.Pt),
+                "moment": json_number(self.M),
+            },
             "moment_residual": json_number(self.M_residual),
             "restitution": json_number(self.e),
             "impulse_ratio": json_number(self.mu),
             "moment_restitution": json_number(self.e_m),
             "critical_impulse_ratio": json_number(self.mu_c),
-            "energy_loss": {"total": json_number(self.TL), "normal": json_number(self.TLn),
-                            "tangential": json_number(self.TLt), "moment": json_number(self.TLm)},
+            "energy_loss": {
+                "total": json_number(self.TL),
+                "normal": json_number(self.TLn),
+                "tangential": json_number(self.TLt),
+                "moment": json_number(self.TLm),
+            },
             "flags": self.flags,
             "warnings": list(self.warnings),
         }
@@ -109,31 +140,44 @@ class Reconstruction:
         speed, energy = f"[{labels['velocity']}]", f"[{labels['energy']}]"
         one, two = self.vehicles
         width = max(14, len(one.name) + 2, len(two.name) + 2)
-        rows = [(f"pre-impact speed {speed}", one.speed, two.speed),
-                (f"velocity x {speed}", one.velocity[0], two.velocity[0]),
-                (f"velocity y {speed}", one.velocity[1], two.velocity[1]),
-                (f"|delta-V| {speed}", one.delta_v_magnitude, two.delta_v_magnitude),
-                *road_speed_rows(self.units, [("pre-impact speed", (one.speed, two.speed)),
-                                              ("|delta-V|", (one.delta_v_magnitude,
-                                                             two.delta_v_magnitude))]),
-                ("PDOF [deg, clockwise]", one.pdof_deg, two.pdof_deg),
-                ("PDOF [o'clock]", one.pdof_clock, two.pdof_clock)]
-        lines = [f"reconstruction, {self.units} units", "",
-                 f"{'':<28}{one.name:>{width}}{two.name:>{width}}"]
-        implied = [("implied restitution e", self.e), ("implied impulse ratio mu", self.mu),
-                   ("critical impulse ratio mu_c", self.mu_c),
-                   ("implied moment restitution e_m", self.e_m),
-                   (f"moment impulse M [{labels['moment']}]", self.M),
-                   (f"  consistency residual [{labels['moment']}]", self.M_residual),
-                   (f"energy loss TL {energy}", self.TL), (f"  normal TLn {energy}", self.TLn),
-                   (f"  tangential TLt {energy}", self.TLt), (f"  moment TLm {energy}", self.TLm)]
+        rows = [
+            (f"pre-impact speed {speed}", one.speed, two.speed),
+            (f"velocity x {speed}", one.velocity[0], two.velocity[0]),
+            (f"velocity y {speed}", one.velocity[1], two.velocity[1]),
+            (f"|delta-V| {speed}", one.delta_v_magnitude, two.delta_v_magnitude),
+            *road_speed_rows(
+                self.units,
+                [
+                    ("pre-impact speed", (one.speed, two.speed)),
+                    ("|delta-V|", (one.delta_v_magnitude, two.delta_v_magnitude)),
+                ],
+            ),
+            ("PDOF [deg, clockwise]", one.pdof_deg, two.pdof_deg),
+            ("PDOF [o'clock]", one.pdof_clock, two.pdof_clock),
+        ]
+        lines = [f"reconstruction, {self.units} units", "", f"{'':<28}{one.name:>{width}}{two.name:>{width}}"]
+        implied = [
+            ("implied restitution e", self.e),
+            ("implied impulse ratio mu", self.mu),
+            ("critical impulse ratio mu_c", self.mu_c),
+            ("implied moment restitution e_m", self.e_m),
+            (f"moment impulse M [{labels['moment']}]", self.M),
+            (f"  consistency residual [{labels['moment']}]", self.M_residual),
+            (f"energy loss TL {energy}", self.TL),
+            (f"  normal TLn {energy}", self.TLn),
+            (f"  tangential TLt {energy}", self.TLt),
+            (f"  moment TLm {energy}", self.TLm),
+        ]
         clean = without_residue(rows + implied)  # rounding residue of a zero shown as 0
-        rows, implied = clean[:len(rows)], clean[len(rows):]
+        rows, implied = clean[: len(rows)], clean[len(rows) :]
         lines += [f"{label:<28}{table_cell(a):>{width}}{table_cell(b):>{width}}" for label, a, b in rows]
         lines.append("")
         lines += [f"{label:<36}{table_cell(value):>14}" for label, value in implied]
-        lines += ["", "warnings:"] + [f"  - {w}" for w in self.warnings] if self.warnings \
+        lines += (
+            ["", "warnings:"] + [f"  - {w}" for w in self.warnings]
+            if self.warnings
             else ["", "warnings: none"]
+        )
         return "\n".join(lines)
 
 
@@ -147,13 +191,20 @@ def reconstruct(scene: Scene | Mapping | str | Path) -> Reconstruction:
     out = _kernels.run_one(_kernels.RECONSTRUCT, values, OUTPUTS)
     if out["status"] != 0:
         raise overflow_error(scene, out["status"]) or SceneError(
-            f"cannot reconstruct the scene: {describe_status(out['status'])}")
+            f"cannot reconstruct the scene: {describe_status(out['status'])}"
+        )
     vehicles = tuple(_vehicle(v, out, values, i) for i, v in enumerate(scene.vehicles, 1))
-    scalars = {k: out[k] for k in ("Pn", "Pt", "M", "M_residual", "e", "mu", "e_m", "mu_c",
-                                   "TL", "TLn", "TLt", "TLm")}
-    return Reconstruction(units=scene.units, vehicles=vehicles, flags=out["flags"],
-                          warnings=describe_flags(out["flags"]) + moment_warnings(out["e_m"])
-                          + list(scene.warnings), **scalars)
+    scalars = {
+        k: out[k]
+        for k in ("Pn", "Pt", "M", "M_residual", "e", "mu", "e_m", "mu_c", "TL", "TLn", "TLt", "TLm")
+    }
+    return Reconstruction(
+        units=scene.units,
+        vehicles=vehicles,
+        flags=out["flags"],
+        warnings=describe_flags(out["flags"]) + moment_warnings(out["e_m"]) + list(scene.warnings),
+        **scalars,
+    )
 
 
 #: The physical range of the moment restitution: e_m is the ratio of the final
@@ -169,9 +220,11 @@ def moment_warnings(e_m: float) -> list[str]:
     low, high = MOMENT_RESTITUTION_RANGE
     if not math.isfinite(e_m) or low <= e_m <= high:
         return []
-    return [f"the implied moment restitution e_m = {e_m:.6g} is outside [{low:g}, {high:g}]: "
-            "the final relative yaw rate exceeds the initial one, which creates rotational "
-            "energy (TLm < 0); check the yaw rates, headings and impact centre"]
+    return [
+        f"the implied moment restitution e_m = {e_m:.6g} is outside [{low:g}, {high:g}]: "
+        "the final relative yaw rate exceeds the initial one, which creates rotational "
+        "energy (TLm < 0); check the yaw rates, headings and impact centre"
+    ]
 
 
 def _inputs(scene: Scene) -> dict:
@@ -179,17 +232,21 @@ def _inputs(scene: Scene) -> dict:
     values = {"gamma": math.radians(scene.impact.normal_angle)}
     for number, vehicle in enumerate(scene.vehicles, start=1):
         if vehicle.fixed:
-            raise SceneError("a reconstruction needs two moving vehicles",
-                             f"vehicles[{number - 1}].fixed")
+            raise SceneError("a reconstruction needs two moving vehicles", f"vehicles[{number - 1}].fixed")
         final = vehicle.extra["final_velocity"]
-        values.update({
-            f"m{number}": vehicle.mass, f"I{number}": vehicle.yaw_inertia,
-            f"V{number}x": final[0], f"V{number}y": final[1],
-            f"W{number}": float(vehicle.extra.get("final_yaw_rate", 0.0)),
-            f"theta{number}": math.radians(vehicle.extra["heading"]),
-            f"w{number}": vehicle.yaw_rate,
-            f"r{number}x": vehicle.impact_point[0], f"r{number}y": vehicle.impact_point[1],
-        })
+        values.update(
+            {
+                f"m{number}": vehicle.mass,
+                f"I{number}": vehicle.yaw_inertia,
+                f"V{number}x": final[0],
+                f"V{number}y": final[1],
+                f"W{number}": float(vehicle.extra.get("final_yaw_rate", 0.0)),
+                f"theta{number}": math.radians(vehicle.extra["heading"]),
+                f"w{number}": vehicle.yaw_rate,
+                f"r{number}x": vehicle.impact_point[0],
+                f"r{number}y": vehicle.impact_point[1],
+            }
+        )
     return values
 
 
@@ -199,6 +256,11 @@ def _vehicle(vehicle, out, values, number: int) -> ReconstructedVehicle:
     clockwise = -math.degrees(out[f"pdof{number}"])
     pdof = (clockwise + 180.0) % 360.0 - 180.0
     return ReconstructedVehicle(
-        name=vehicle.name, speed=out[f"s{number}"], velocity=velocity, delta_v=delta,
-        delta_v_magnitude=math.hypot(*delta), pdof_deg=pdof,
-        pdof_clock=(round(pdof / 30.0) - 1) % 12 + 1)
+        name=vehicle.name,
+        speed=out[f"s{number}"],
+        velocity=velocity,
+        delta_v=delta,
+        delta_v_magnitude=math.hypot(*delta),
+        pdof_deg=pdof,
+        pdof_clock=(round(pdof / 30.0) - 1) % 12 + 1,
+    )

@@ -17,12 +17,29 @@ from typing import Any
 from .codes import describe_flags
 from .scene import Scene, uses_yaw
 
-__all__ = ["Result", "VehicleResult", "UNIT_LABELS", "ROAD_SPEED", "json_number", "road_speed_rows",
-           "scene_warnings", "table_cell", "without_residue", "TABLE_RESIDUE", "json_clean"]
+__all__ = [
+    "Result",
+    "VehicleResult",
+    "UNIT_LABELS",
+    "ROAD_SPEED",
+    "json_number",
+    "road_speed_rows",
+    "scene_warnings",
+    "table_cell",
+    "without_residue",
+    "TABLE_RESIDUE",
+    "json_clean",
+]
 
 UNIT_LABELS = {
     "SI": {"velocity": "m/s", "yaw_rate": "rad/s", "impulse": "N·s", "moment": "N·m·s", "energy": "J"},
-    "US": {"velocity": "ft/s", "yaw_rate": "rad/s", "impulse": "lb·s", "moment": "ft·lb·s", "energy": "ft·lb"},
+    "US": {
+        "velocity": "ft/s",
+        "yaw_rate": "rad/s",
+        "impulse": "lb·s",
+        "moment": "ft·lb·s",
+        "energy": "ft·lb",
+    },
 }
 
 #: The speed unit people read in each system, and its factor from the system's
@@ -116,7 +133,11 @@ class Result:
             "model": self.model,
             "units": self.units,
             "vehicles": [vehicle.to_json_dict() for vehicle in self.vehicles],
-            "impulse": {"normal": json_number(self.Pn), "tangential": json_number(self.Pt), "moment": json_number(self.M)},
+            "impulse": {
+                "normal": json_number(self.Pn),
+                "tangential": json_number(self.Pt),
+                "moment": json_number(self.M),
+            },
             "impulse_ratio": json_number(self.mu),
             "critical_impulse_ratio": json_number(self.mu_c),
             "energy_loss": {
@@ -141,8 +162,10 @@ class Result:
         lines.append(f"{'':<28}{one.name:>{width}}{two.name:>{width}}")
         vehicle_rows, impact_rows = self._vehicle_rows(), self._impact_rows()
         clean = without_residue(vehicle_rows + impact_rows)
-        vehicle_rows, impact_rows = clean[:len(vehicle_rows)], clean[len(vehicle_rows):]
-        lines += [f"{label:<28}{table_cell(a):>{width}}{table_cell(b):>{width}}" for label, a, b in vehicle_rows]
+        vehicle_rows, impact_rows = clean[: len(vehicle_rows)], clean[len(vehicle_rows) :]
+        lines += [
+            f"{label:<28}{table_cell(a):>{width}}{table_cell(b):>{width}}" for label, a, b in vehicle_rows
+        ]
         lines.append("")
         lines += [f"{label:<36}{table_cell(value):>14}" for label, value in impact_rows]
         lines.append("")
@@ -166,9 +189,13 @@ class Result:
             (f"delta-V y {speed}", one.delta_v[1], two.delta_v[1]),
             (f"|delta-V| {speed}", one.delta_v_magnitude, two.delta_v_magnitude),
         ]
-        rows += road_speed_rows(self.units, [
-            (f"{when} speed", [math.hypot(*v.velocity) for v in self.vehicles]),
-            ("|delta-V|", [v.delta_v_magnitude for v in self.vehicles])])
+        rows += road_speed_rows(
+            self.units,
+            [
+                (f"{when} speed", [math.hypot(*v.velocity) for v in self.vehicles]),
+                ("|delta-V|", [v.delta_v_magnitude for v in self.vehicles]),
+            ],
+        )
         rows.append((f"{when} yaw rate [deg/s]", math.degrees(one.yaw_rate), math.degrees(two.yaw_rate)))
         return [row for row in rows if uses_yaw(self.model) or "yaw" not in row[0]]
 
@@ -205,8 +232,10 @@ def scene_warnings(scene: Scene) -> list[str]:
     if scene.uses_yaw and not -1.0 <= impact.moment_restitution <= 1.0:
         warnings.append(f"impact.moment_restitution = {impact.moment_restitution:g} is outside [-1, 1]")
     if impact.slip is not None and not 0.0 <= impact.slip <= 1.0:
-        warnings.append(f"impact.slip = {impact.slip:g} is outside [0, 1]: the final tangential "
-                        "slip would reverse or exceed the initial one")
+        warnings.append(
+            f"impact.slip = {impact.slip:g} is outside [0, 1]: the final tangential "
+            "slip would reverse or exceed the initial one"
+        )
     for index, vehicle in enumerate(scene.vehicles):
         if vehicle.fixed and (vehicle.velocity != (0.0, 0.0) or vehicle.yaw_rate != 0.0):
             warnings.append(
@@ -232,8 +261,10 @@ def road_speed_rows(units: str, speeds) -> list[tuple]:
     """Table rows of speeds (``(label, [per vehicle])`` in the system's speed
     unit, None where unknown) in the unit people read: mph (US) or km/h (SI)."""
     label, factor = ROAD_SPEED[units]
-    return [(f"{name} [{label}]", *(None if value is None else factor * value for value in values))
-            for name, values in speeds]
+    return [
+        (f"{name} [{label}]", *(None if value is None else factor * value for value in values))
+        for name, values in speeds
+    ]
 
 
 def table_cell(value: float) -> str:
@@ -256,8 +287,16 @@ def without_residue(rows: list[tuple]) -> list[tuple]:
     for label, *values in rows:
         unit = _unit_of(label)
         scales[unit] = max([scales.get(unit, 0.0)] + [abs(v) for v in values if _is_float(v)])
-    return [(label, *(0.0 if _is_float(v) and abs(v) < TABLE_RESIDUE * scales[_unit_of(label)]
-                      else v for v in values)) for label, *values in rows]
+    return [
+        (
+            label,
+            *(
+                0.0 if _is_float(v) and abs(v) < TABLE_RESIDUE * scales[_unit_of(label)] else v
+                for v in values
+            ),
+        )
+        for label, *values in rows
+    ]
 
 
 def _unit_of(label: str) -> str:

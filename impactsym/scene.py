@@ -82,8 +82,7 @@ KINDS = ("forward", "inverse", "reconstruct", "crash3")
 #: Vehicle entries Scene.to_dict leaves out for a kind that does not read them.
 _TO_DICT_LEFT_OUT = {"inverse": ("velocity", "yaw_rate"), "reconstruct": ("velocity",)}
 #: The command that reads each kind of scene (for "not used" warnings).
-COMMAND = {"forward": "solve", "inverse": "invert", "reconstruct": "reconstruct",
-           "crash3": "crash3"}
+COMMAND = {"forward": "solve", "inverse": "invert", "reconstruct": "reconstruct", "crash3": "crash3"}
 
 
 @dataclass(frozen=True)
@@ -121,8 +120,9 @@ class Vehicle:
             "impact_point": list(self.impact_point),
             "fixed": self.fixed,
         }
-        entry.update({key: list(value) if isinstance(value, tuple) else value
-                      for key, value in self.extra.items()})
+        entry.update(
+            {key: list(value) if isinstance(value, tuple) else value for key, value in self.extra.items()}
+        )
         return {key: value for key, value in entry.items() if value is not None}
 
 
@@ -161,8 +161,11 @@ class Impact:
             "moment_restitution": self.moment_restitution,
             "slip": self.slip,
         }
-        return {key: value for key, value in entry.items()
-                if value is not None and not (isinstance(value, float) and math.isnan(value))}
+        return {
+            key: value
+            for key, value in entry.items()
+            if value is not None and not (isinstance(value, float) and math.isnan(value))
+        }
 
 
 @dataclass(frozen=True)
@@ -198,8 +201,9 @@ class Scene:
         """The uncertain leaves as ``(path, kind, params)``, params in scene
         units (normal: mean, sd; uniform: low, high; triangular: low, mode,
         high; angles in degrees)."""
-        return tuple((leaf.path, leaf.kind, leaf.params) for leaf in self.leaves.values()
-                     if leaf.kind is not None)
+        return tuple(
+            (leaf.path, leaf.kind, leaf.params) for leaf in self.leaves.values() if leaf.kind is not None
+        )
 
     def to_dict(self) -> dict[str, Any]:
         """The scene in plain scene-file form (what :func:`load_scene` reads back):
@@ -310,8 +314,10 @@ def _read_file(path: Path) -> Any:
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path}: invalid TOML: {exc}") from None
     except _DuplicateKey as exc:
-        raise SceneError(f'{path}: invalid JSON: the key "{exc.args[0]}" is given twice in one '
-                         "object (the second would silently replace the first)") from None
+        raise SceneError(
+            f'{path}: invalid JSON: the key "{exc.args[0]}" is given twice in one '
+            "object (the second would silently replace the first)"
+        ) from None
     except RecursionError:
         kind = "JSON" if suffix == ".json" else "TOML"
         raise SceneError(f"{path}: invalid {kind}: nested too deeply") from None
@@ -350,8 +356,11 @@ class _Reading:
 
     def used_leaves(self) -> dict[str, Leaf]:
         """The leaves of the keys the command uses."""
-        return {path: leaf for path, leaf in self.leaves.leaves.items()
-                if not any(path == p or path.startswith((p + ".", p + "[")) for p in self.unused)}
+        return {
+            path: leaf
+            for path, leaf in self.leaves.leaves.items()
+            if not any(path == p or path.startswith((p + ".", p + "[")) for p in self.unused)
+        }
 
 
 def _parse_scene(data: Any, source: Path | None, kind: str) -> Scene:
@@ -377,10 +386,11 @@ def _parse_scene(data: Any, source: Path | None, kind: str) -> Scene:
         raise SceneError("both vehicles are fixed; at most one may be", "vehicles")
     coefficients = _parse_coefficients(impact_data, reading)
     if not no_impact:
-        reading.leaves.number(_require(impact_data, "normal_angle", "impact"), "impact.normal_angle",
-                              "angle")
-    extras = [_read_vehicle(entry, index, is_fixed, reading)
-              for index, (entry, is_fixed) in enumerate(zip(raw_vehicles, fixed))]
+        reading.leaves.number(_require(impact_data, "normal_angle", "impact"), "impact.normal_angle", "angle")
+    extras = [
+        _read_vehicle(entry, index, is_fixed, reading)
+        for index, (entry, is_fixed) in enumerate(zip(raw_vehicles, fixed))
+    ]
     leaves = reading.used_leaves()
     correlations = parse_correlations(data["correlations"], leaves) if "correlations" in data else ()
     values = {path: leaf.nominal for path, leaf in reading.leaves.leaves.items()}
@@ -392,18 +402,22 @@ def _parse_scene(data: Any, source: Path | None, kind: str) -> Scene:
     if flipped:
         reading.warnings.append(
             f"impact.normal_angle = {given:g} deg points from vehicle 2 toward vehicle 1; "
-            f"the opposite sense, {float(angle):g} deg, is used (n·(r1 - r2) > 0)")
+            f"the opposite sense, {float(angle):g} deg, is used (n·(r1 - r2) > 0)"
+        )
     impact = Impact(normal_angle=float(angle), **coefficients)
-    vehicles = tuple(_vehicle(raw, index, is_fixed, state, extra)
-                     for index, (raw, is_fixed, state, extra)
-                     in enumerate(zip(raw_vehicles, fixed, states, extras)))
-    extra = {key: data[key] for key in data
-             if key not in ("model", "units", "impact", "vehicles", "correlations")}
+    vehicles = tuple(
+        _vehicle(raw, index, is_fixed, state, extra)
+        for index, (raw, is_fixed, state, extra) in enumerate(zip(raw_vehicles, fixed, states, extras))
+    )
+    extra = {
+        key: data[key] for key in data if key not in ("model", "units", "impact", "vehicles", "correlations")
+    }
     warnings = reading.warnings
     if kind in ("forward", "inverse"):
         warnings += _unused_coefficients(impact_data, model)
-    return Scene(model, units, impact, vehicles, source, extra, tuple(warnings), kind, leaves,
-                 correlations, data)
+    return Scene(
+        model, units, impact, vehicles, source, extra, tuple(warnings), kind, leaves, correlations, data
+    )
 
 
 def _vehicle_list(raw: Any) -> list:
@@ -427,8 +441,11 @@ def _parse_coefficients(data: Mapping, reading: _Reading) -> dict[str, Any]:
     preset says which the scene gives and which it fixes). A reconstruction
     infers them and CRASH3 uses none: there they are reported as not used."""
     if reading.kind in ("reconstruct", "crash3"):
-        why = ("a reconstruction infers them from the motion" if reading.kind == "reconstruct"
-               else "CRASH3 takes its restitution from the crash3 options")
+        why = (
+            "a reconstruction infers them from the motion"
+            if reading.kind == "reconstruct"
+            else "CRASH3 takes its restitution from the crash3 options"
+        )
         for key in COEFFICIENT_KEYS:
             if key in data:
                 reading.not_used(f"impact.{key}", why)
@@ -436,8 +453,11 @@ def _parse_coefficients(data: Mapping, reading: _Reading) -> dict[str, Any]:
     preset = PRESETS[reading.model]
     coefficients = {key: _coefficient(data, key, preset, reading) for key in COEFFICIENT_KEYS}
     if reading.kind == "inverse" and coefficients["impulse_ratio"] == CRITICAL:
-        raise SceneError('must be a number for an inverse solution: with "critical" the final '
-                         "velocities do not determine the tangential slip", "impact.impulse_ratio")
+        raise SceneError(
+            'must be a number for an inverse solution: with "critical" the final '
+            "velocities do not determine the tangential slip",
+            "impact.impulse_ratio",
+        )
     return coefficients
 
 
@@ -467,8 +487,9 @@ def _impulse_ratio(value: Any, reading: _Reading) -> float | str:
     except SceneError as exc:
         if isinstance(value, Mapping) or (isinstance(value, str) and any(c.isdigit() for c in value)):
             raise
-        raise SceneError(f'must be a finite number or "critical", got {show_value(value)}',
-                         "impact.impulse_ratio") from exc
+        raise SceneError(
+            f'must be a finite number or "critical", got {show_value(value)}', "impact.impulse_ratio"
+        ) from exc
 
 
 def _unused_coefficients(data: Mapping, model: str) -> list[str]:
@@ -479,8 +500,10 @@ def _unused_coefficients(data: Mapping, model: str) -> list[str]:
         if key not in data:
             continue
         if key in preset["fixed"] and data[key] != preset["fixed"][key]:
-            warnings.append(f"impact.{key} = {show_value(data[key])} is not used: the {model} model "
-                            f"fixes it at {show_value(preset['fixed'][key])}")
+            warnings.append(
+                f"impact.{key} = {show_value(data[key])} is not used: the {model} model "
+                f"fixes it at {show_value(preset['fixed'][key])}"
+            )
         elif key not in preset["fixed"] and key not in (*preset["required"], *preset["optional"]):
             warnings.append(f"impact.{key} is not used by the {model} model")
     return warnings
@@ -501,20 +524,32 @@ _REQUIRED = {
     "crash3": ("crush",),
 }
 _NOT_USED = {
-    "forward": {"final_velocity": "solve starts from the initial motion",
-                "final_yaw_rate": "solve starts from the initial motion",
-                "crush": "crush tables are read by crash3 and compare"},
-    "inverse": {"velocity": "invert computes the initial motion",
-                "yaw_rate": "invert computes the initial motion",
-                "crush": "crush tables are read by crash3 and compare"},
-    "reconstruct": {"velocity": "reconstruct computes the pre-impact velocity from the heading",
-                    "crush": "crush tables are read by crash3 and compare"},
+    "forward": {
+        "final_velocity": "solve starts from the initial motion",
+        "final_yaw_rate": "solve starts from the initial motion",
+        "crush": "crush tables are read by crash3 and compare",
+    },
+    "inverse": {
+        "velocity": "invert computes the initial motion",
+        "yaw_rate": "invert computes the initial motion",
+        "crush": "crush tables are read by crash3 and compare",
+    },
+    "reconstruct": {
+        "velocity": "reconstruct computes the pre-impact velocity from the heading",
+        "crush": "crush tables are read by crash3 and compare",
+    },
     "crash3": {"final_velocity": "CRASH3 works from crush", "final_yaw_rate": "CRASH3 works from crush"},
 }
-_NOT_USED_BY_PARTICLES = ("yaw_inertia", "radius_of_gyration", "yaw_rate", "final_yaw_rate",
-                          "impact_point")
-_NOT_USED_BY_FIXED = ("mass", "weight", "yaw_inertia", "radius_of_gyration", "crush",
-                      "final_velocity", "final_yaw_rate")
+_NOT_USED_BY_PARTICLES = ("yaw_inertia", "radius_of_gyration", "yaw_rate", "final_yaw_rate", "impact_point")
+_NOT_USED_BY_FIXED = (
+    "mass",
+    "weight",
+    "yaw_inertia",
+    "radius_of_gyration",
+    "crush",
+    "final_velocity",
+    "final_yaw_rate",
+)
 
 
 def _read_vehicle(data: Mapping, index: int, fixed: bool, reading: _Reading) -> dict[str, Any]:
@@ -545,8 +580,12 @@ def _read_vehicle(data: Mapping, index: int, fixed: bool, reading: _Reading) -> 
             if key not in data and not (key in _ALTERNATIVE and _ALTERNATIVE[key] in data):
                 raise SceneError("missing", f"{path}.{key}")
     leaves = reading.leaves
-    for key, dimension in (("mass", "mass"), ("weight", "force"), ("yaw_inertia", "inertia"),
-                           ("radius_of_gyration", "length")):
+    for key, dimension in (
+        ("mass", "mass"),
+        ("weight", "force"),
+        ("yaw_inertia", "inertia"),
+        ("radius_of_gyration", "length"),
+    ):
         if key in data:
             leaves.number(data[key], f"{path}.{key}", dimension, "positive")
     for key in ("velocity", "final_velocity"):
@@ -558,10 +597,16 @@ def _read_vehicle(data: Mapping, index: int, fixed: bool, reading: _Reading) -> 
     if "impact_point" in data:
         leaves.vector(data["impact_point"], f"{path}.impact_point", "length", "impact_point")
         if isinstance(data["impact_point"], Mapping) and "heading" not in data:
-            raise SceneError("in the vehicle frame ({forward, left} or {distance, angle}) it needs "
-                             f"the vehicle's heading ({path}.heading)", f"{path}.impact_point")
-    extra = {key: leaves.number(data[key], f"{path}.{key}", "length", "positive")
-             for key in ("length", "width") if key in data}
+            raise SceneError(
+                "in the vehicle frame ({forward, left} or {distance, angle}) it needs "
+                f"the vehicle's heading ({path}.heading)",
+                f"{path}.impact_point",
+            )
+    extra = {
+        key: leaves.number(data[key], f"{path}.{key}", "length", "positive")
+        for key in ("length", "width")
+        if key in data
+    }
     if "crush" in data:
         extra["crush"] = _crush(data["crush"], f"{path}.crush", leaves)
     return extra
@@ -583,8 +628,9 @@ def _crush(raw: Any, path: str, leaves: LeafReader) -> dict[str, Any]:
             crush[key] = leaves.number(data[key], f"{path}.{key}", dimension)
     depths = data.get("depths")
     if isinstance(depths, list):
-        crush["depths"] = [leaves.number(value, f"{path}.depths[{i}]", "crush_length")
-                           for i, value in enumerate(depths)]
+        crush["depths"] = [
+            leaves.number(value, f"{path}.depths[{i}]", "crush_length") for i, value in enumerate(depths)
+        ]
     return crush
 
 
@@ -699,6 +745,7 @@ def _positive(value: Any, path: str) -> float:
 
 # --------------------------------------------------------------------------- columns of draws
 
+
 @dataclass(frozen=True)
 class SceneColumns:
     """Kernel input columns of a scene with some leaves replaced by arrays.
@@ -734,8 +781,11 @@ class SceneColumns:
 
 
 #: Physical ranges of coefficients, checked on drawn values.
-_COEFFICIENT_RANGES = {"impact.restitution": (0.0, 1.0), "impact.moment_restitution": (-1.0, 1.0),
-                       "impact.slip": (0.0, 1.0)}
+_COEFFICIENT_RANGES = {
+    "impact.restitution": (0.0, 1.0),
+    "impact.moment_restitution": (-1.0, 1.0),
+    "impact.slip": (0.0, 1.0),
+}
 
 
 def scene_columns(scene: Scene, overrides: Mapping[str, Any] | None = None) -> SceneColumns:
@@ -756,8 +806,9 @@ def scene_columns(scene: Scene, overrides: Mapping[str, Any] | None = None) -> S
             outside = ~((arrays[path] >= low) & (arrays[path] <= high))
             reason[outside & (reason == "")] = f"{path} is outside [{low:g}, {high:g}]"
     states = [_row_state(scene, values, index) for index in range(2)]
-    angle, flipped = used_normal_angle(values.get("impact.normal_angle", math.nan), states[0]["r"],
-                                       states[1]["r"])
+    angle, flipped = used_normal_angle(
+        values.get("impact.normal_angle", math.nan), states[0]["r"], states[1]["r"]
+    )
     gamma = np.deg2rad(angle) if np.ndim(angle) else math.radians(float(angle))
     columns = _KIND_COLUMNS[scene.kind](scene, values, states, gamma)
     return SceneColumns(scene.kind, scene.model, rows, columns, reason, flipped)
@@ -849,17 +900,21 @@ def _crash3_columns(scene: Scene, values, states, gamma) -> dict[str, Any]:
         columns[f"m{number}"] = state["m"]
         columns[f"I{number}"] = math.inf if state["I"] is None else state["I"]
         columns[f"r{number}x"], columns[f"r{number}y"] = state["r"]
-    columns["crush"] = [None if vehicle.fixed else _crush_columns(values, index)
-                        for index, vehicle in enumerate(scene.vehicles)]
+    columns["crush"] = [
+        None if vehicle.fixed else _crush_columns(values, index)
+        for index, vehicle in enumerate(scene.vehicles)
+    ]
     return columns
 
 
 def _crush_columns(values: Mapping, index: int) -> dict[str, Any]:
     """The crush-energy kernel inputs of vehicle ``index`` from its crush leaves."""
     prefix = f"vehicles[{index}].crush"
-    columns = {key: values[f"{prefix}.{key}"] for key in ("A", "B", "width", "moment_arm",
-                                                          "radius_of_gyration")
-               if f"{prefix}.{key}" in values}
+    columns = {
+        key: values[f"{prefix}.{key}"]
+        for key in ("A", "B", "width", "moment_arm", "radius_of_gyration")
+        if f"{prefix}.{key}" in values
+    }
     if f"{prefix}.pdof" in values:
         columns["alpha"] = np.deg2rad(values[f"{prefix}.pdof"])
     depth = 0
@@ -869,5 +924,9 @@ def _crush_columns(values: Mapping, index: int) -> dict[str, Any]:
     return columns
 
 
-_KIND_COLUMNS = {"forward": _forward_columns, "inverse": _inverse_columns,
-                 "reconstruct": _reconstruct_columns, "crash3": _crash3_columns}
+_KIND_COLUMNS = {
+    "forward": _forward_columns,
+    "inverse": _inverse_columns,
+    "reconstruct": _reconstruct_columns,
+    "crash3": _crash3_columns,
+}

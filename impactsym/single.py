@@ -59,9 +59,12 @@ def overflow_error(scene: Scene, status: int) -> SceneError | None:
         return None
     value = scene.leaves[worst].nominal
     size = "large" if abs(value) > 1.0 else "small"
-    return SceneError(f"{value:g} is too {size}: the results of the impact are not finite (overflow); "
-                      f"keep every input between {SAFE_MAGNITUDE[0]:g} and {SAFE_MAGNITUDE[1]:g} "
-                      "in magnitude (scene units)", worst)
+    return SceneError(
+        f"{value:g} is too {size}: the results of the impact are not finite (overflow); "
+        f"keep every input between {SAFE_MAGNITUDE[0]:g} and {SAFE_MAGNITUDE[1]:g} "
+        "in magnitude (scene units)",
+        worst,
+    )
 
 
 def status_reason(status: int) -> str:

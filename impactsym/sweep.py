@@ -57,9 +57,22 @@ from ._util import CHUNK_SIZE, require, spans
 from .dask_engine import map_chunks
 from .scene import show_value
 
-__all__ = ["sweep", "sample", "percentiles", "summary_columns", "GridPlan", "SamplePlan", "collect", "summarize",
-           "write_frame",
-           "CHUNK_SIZE", "BLOCK", "DISTRIBUTIONS", "PERCENTILES", "SWEEP_PERCENTILES"]
+__all__ = [
+    "sweep",
+    "sample",
+    "percentiles",
+    "summary_columns",
+    "GridPlan",
+    "SamplePlan",
+    "collect",
+    "summarize",
+    "write_frame",
+    "CHUNK_SIZE",
+    "BLOCK",
+    "DISTRIBUTIONS",
+    "PERCENTILES",
+    "SWEEP_PERCENTILES",
+]
 
 #: Work larger than this many rows shows a progress bar on a terminal (about a second).
 PROGRESS_ROWS = 5_000_000
@@ -72,8 +85,18 @@ SWEEP_PERCENTILES = (0, 50, 100)
 
 # --------------------------------------------------------------------------- public API
 
-def sweep(scene, *, outputs=None, engine: str = "local", chunk_size: int = CHUNK_SIZE, out=None,
-          progress=None, as_xarray: bool = False, **values):
+
+def sweep(
+    scene,
+    *,
+    outputs=None,
+    engine: str = "local",
+    chunk_size: int = CHUNK_SIZE,
+    out=None,
+    progress=None,
+    as_xarray: bool = False,
+    **values,
+):
     """Solve the cartesian grid of ``values`` around a base scene.
 
     ``scene`` is a scene file path, a mapping in scene-file form or a
@@ -113,14 +136,25 @@ def sweep(scene, *, outputs=None, engine: str = "local", chunk_size: int = CHUNK
         require("xarray", extra="xarray", what="sweep(as_xarray=True)")
     plan = GridPlan.build(scene, values, outputs)
     if out is not None:
-        return summarize(plan, out=out, q=SWEEP_PERCENTILES, engine=engine, chunk_size=chunk_size,
-                         progress=progress)
+        return summarize(
+            plan, out=out, q=SWEEP_PERCENTILES, engine=engine, chunk_size=chunk_size, progress=progress
+        )
     frame = collect(plan, engine=engine, chunk_size=chunk_size, progress=progress)
     return plan.to_xarray(frame) if as_xarray else frame
 
 
-def sample(scene, dists: Mapping, n: int, *, seed=None, outputs=None, engine: str = "local",
-           chunk_size: int = CHUNK_SIZE, out=None, progress=None):
+def sample(
+    scene,
+    dists: Mapping,
+    n: int,
+    *,
+    seed=None,
+    outputs=None,
+    engine: str = "local",
+    chunk_size: int = CHUNK_SIZE,
+    out=None,
+    progress=None,
+):
     """Monte Carlo: solve ``n`` scenes whose inputs are drawn from ``dists``.
 
     ``dists`` maps input names (as for `sweep`, in the scene's units,
@@ -147,8 +181,9 @@ def sample(scene, dists: Mapping, n: int, *, seed=None, outputs=None, engine: st
     """
     plan = SamplePlan.build(scene, dists, n, seed, outputs)
     if out is not None:
-        result = summarize(plan, out=out, q=PERCENTILES, engine=engine, chunk_size=chunk_size,
-                           progress=progress)
+        result = summarize(
+            plan, out=out, q=PERCENTILES, engine=engine, chunk_size=chunk_size, progress=progress
+        )
     else:
         result = collect(plan, engine=engine, chunk_size=chunk_size, progress=progress)
     result.attrs["seed"] = plan.entropy
@@ -184,6 +219,7 @@ def percentiles(df, columns=SUMMARY_COLUMNS, q=PERCENTILES):
 
 # --------------------------------------------------------------------------- running chunks
 
+
 def _frames(plan, engine: str, chunk_size: int) -> Iterator:
     """Every chunk of ``plan`` solved, in row order, by the chosen engine."""
     if not is_integer(chunk_size) or chunk_size < 1:
@@ -204,8 +240,9 @@ def collect(plan, *, engine: str = "local", chunk_size: int = CHUNK_SIZE, progre
     return frames[0] if len(frames) == 1 else pd.concat(frames)
 
 
-def summarize(plan, *, out=None, q=PERCENTILES, engine: str = "local", chunk_size: int = CHUNK_SIZE,
-              progress=None):
+def summarize(
+    plan, *, out=None, q=PERCENTILES, engine: str = "local", chunk_size: int = CHUNK_SIZE, progress=None
+):
     """Stream every chunk of ``plan`` to ``out`` (a ``.parquet`` or ``.csv``
     path, or None for no file) and return ``percentiles`` of the rows for the
     default summary columns the outputs include, with bounded memory: the
@@ -276,5 +313,3 @@ def _check_columns(df, names) -> None:
     for name in names:
         if name not in df:
             raise ValueError(f"{name}: not a column of the result")
-
-

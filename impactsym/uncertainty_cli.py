@@ -22,14 +22,28 @@ DEFAULT_DRAWS = 10_000
 def add_arguments(parser: argparse.ArgumentParser, plot: bool = False) -> None:
     """The uncertainty options of a command (`plot`: also add ``--plot``)."""
     group = parser.add_argument_group("uncertainty")
-    group.add_argument("--uncertainty", action="store_true",
-                       help="propagate the scene's distributions: Monte Carlo, linear sd, budget")
-    group.add_argument("--draws", type=int, default=DEFAULT_DRAWS, metavar="N",
-                       help=f"Monte Carlo draws (default {DEFAULT_DRAWS})")
-    group.add_argument("--seed", type=int, default=None, metavar="S",
-                       help="seed of the draws (default: fresh entropy, printed)")
-    group.add_argument("--sobol", action="store_true",
-                       help="also Sobol first-order and total indices (SALib)")
+    group.add_argument(
+        "--uncertainty",
+        action="store_true",
+        help="propagate the scene's distributions: Monte Carlo, linear sd, budget",
+    )
+    group.add_argument(
+        "--draws",
+        type=int,
+        default=DEFAULT_DRAWS,
+        metavar="N",
+        help=f"Monte Carlo draws (default {DEFAULT_DRAWS})",
+    )
+    group.add_argument(
+        "--seed",
+        type=int,
+        default=None,
+        metavar="S",
+        help="seed of the draws (default: fresh entropy, printed)",
+    )
+    group.add_argument(
+        "--sobol", action="store_true", help="also Sobol first-order and total indices (SALib)"
+    )
     if plot:
         group.add_argument("--plot", metavar="OUT.png", help="with --uncertainty: histograms and budget")
 
@@ -37,8 +51,9 @@ def add_arguments(parser: argparse.ArgumentParser, plot: bool = False) -> None:
 def run(args: argparse.Namespace, command: str, result, **options) -> int:
     """Print `result` with the uncertainty of `command` for ``args.scene``."""
     try:
-        u = uncertainty(args.scene, command=command, draws=args.draws, seed=args.seed,
-                        sobol=args.sobol, **options)
+        u = uncertainty(
+            args.scene, command=command, draws=args.draws, seed=args.seed, sobol=args.sobol, **options
+        )
     except (ValueError, ImportError) as exc:  # a one-line reason, exit code 2
         raise SceneError(str(exc)) from None
     if getattr(args, "plot", None):
@@ -46,8 +61,9 @@ def run(args: argparse.Namespace, command: str, result, **options) -> int:
 
         save_uncertainty_plot(u, args.plot)
     if args.json:
-        print(json.dumps({**result.to_json_dict(), "uncertainty": u.to_json_dict()}, indent=2,
-                         allow_nan=False))
+        print(
+            json.dumps({**result.to_json_dict(), "uncertainty": u.to_json_dict()}, indent=2, allow_nan=False)
+        )
     else:
         print(result.table())
         print()

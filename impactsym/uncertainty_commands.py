@@ -51,16 +51,16 @@ def _forward_outputs(c: Mapping, o: Mapping, yaw: bool) -> dict:
         out[f"{v}.delta_v[0]"] = o[f"V{i}x"] - c[f"v{i}x"]
         out[f"{v}.delta_v[1]"] = o[f"V{i}y"] - c[f"v{i}y"]
         out[f"{v}.delta_v_magnitude"] = o[f"dV{i}"]
-    return {**out, **_impulse_energy(o, yaw), "impulse_ratio": o["mu"],
-            "critical_impulse_ratio": o["mu_c"]}
+    return {**out, **_impulse_energy(o, yaw), "impulse_ratio": o["mu"], "critical_impulse_ratio": o["mu_c"]}
 
 
 def _impulse_energy(o: Mapping, yaw: bool) -> dict:
     out = {"impulse.normal": o["Pn"], "impulse.tangential": o["Pt"]}
     if yaw:
         out["impulse.moment"] = o["M"]
-    out.update({"energy_loss.total": o["TL"], "energy_loss.normal": o["TLn"],
-                "energy_loss.tangential": o["TLt"]})
+    out.update(
+        {"energy_loss.total": o["TL"], "energy_loss.normal": o["TLn"], "energy_loss.tangential": o["TLt"]}
+    )
     if yaw:
         out["energy_loss.moment"] = o["TLm"]
     return out
@@ -76,8 +76,7 @@ def _inverse_outputs(c: Mapping, o: Mapping, yaw: bool) -> dict:
         dx, dy = c[f"V{i}x"] - o[f"v{i}x"], c[f"V{i}y"] - o[f"v{i}y"]
         out[f"{v}.delta_v[0]"], out[f"{v}.delta_v[1]"] = dx, dy
         out[f"{v}.delta_v_magnitude"] = _hypot(dx, dy)
-    return {**out, **_impulse_energy(o, yaw), "impulse_ratio": c["mu"],
-            "critical_impulse_ratio": o["mu_c"]}
+    return {**out, **_impulse_energy(o, yaw), "impulse_ratio": c["mu"], "critical_impulse_ratio": o["mu_c"]}
 
 
 def _reconstruct_outputs(c: Mapping, o: Mapping, yaw: bool = True) -> dict:
@@ -90,9 +89,15 @@ def _reconstruct_outputs(c: Mapping, o: Mapping, yaw: bool = True) -> dict:
         out[f"{v}.delta_v[0]"], out[f"{v}.delta_v[1]"] = dx, dy
         out[f"{v}.delta_v_magnitude"] = _hypot(dx, dy)
         out[f"{v}.pdof_deg"] = _clockwise_deg(o[f"pdof{i}"])
-    return {**out, **_impulse_energy(o, True), "moment_residual": o["M_residual"],
-            "restitution": o["e"], "impulse_ratio": o["mu"], "moment_restitution": o["e_m"],
-            "critical_impulse_ratio": o["mu_c"]}
+    return {
+        **out,
+        **_impulse_energy(o, True),
+        "moment_residual": o["M_residual"],
+        "restitution": o["e"],
+        "impulse_ratio": o["mu"],
+        "moment_restitution": o["e_m"],
+        "critical_impulse_ratio": o["mu_c"],
+    }
 
 
 @dataclass(frozen=True)
@@ -122,19 +127,30 @@ def _forward_command(model: str) -> Command:
         extra = {k: v for k, v in fixed.items() if k != "mu"}
         return _kernels.JACOBIAN[family + ("_critical" if critical else "")], extra
 
-    return Command("solve", lambda c: _split(solve_batch(c, model=model)), kernel,
-                   lambda c, o: _forward_outputs(c, o, yaw))
+    return Command(
+        "solve",
+        lambda c: _split(solve_batch(c, model=model)),
+        kernel,
+        lambda c, o: _forward_outputs(c, o, yaw),
+    )
 
 
 def _inverse_command(family: str) -> Command:
     yaw = family != "particle"
-    return Command("invert", lambda c: _split(invert_batch(c, model=family)),
-                   lambda c: (_kernels.JACOBIAN[f"{family}_inverse"], {}),
-                   lambda c, o: _inverse_outputs(c, o, yaw))
+    return Command(
+        "invert",
+        lambda c: _split(invert_batch(c, model=family)),
+        lambda c: (_kernels.JACOBIAN[f"{family}_inverse"], {}),
+        lambda c, o: _inverse_outputs(c, o, yaw),
+    )
 
 
-RECONSTRUCT = Command("reconstruct", lambda c: _split(reconstruct_batch(c)),
-                      lambda c: (_kernels.JACOBIAN["reconstruct"], {}), _reconstruct_outputs)
+RECONSTRUCT = Command(
+    "reconstruct",
+    lambda c: _split(reconstruct_batch(c)),
+    lambda c: (_kernels.JACOBIAN["reconstruct"], {}),
+    _reconstruct_outputs,
+)
 
 
 def _split(result: Mapping):
@@ -143,6 +159,7 @@ def _split(result: Mapping):
 
 
 # --------------------------------------------------------------------------- CRASH3: a chain of kernels
+
 
 def _crash3_stages(c: Mapping, units: str, e: float, tangents: list | None = None):
     """CRASH3 over columns `c` (scene_columns' crash3 form): per vehicle the
@@ -153,8 +170,10 @@ def _crash3_stages(c: Mapping, units: str, e: float, tangents: list | None = Non
     from .crash3 import ENERGY_FACTOR
 
     factor = ENERGY_FACTOR[units]
-    n = max([np.size(v) for k, v in c.items() if k != "crush"] + [
-        np.size(v) for crush in c["crush"] if crush for v in crush.values()])
+    n = max(
+        [np.size(v) for k, v in c.items() if k != "crush"]
+        + [np.size(v) for crush in c["crush"] if crush for v in crush.values()]
+    )
     vals, status = {}, np.zeros(n, dtype=np.int32)
     tan = [dict(t) for t in tangents] if tangents is not None else None
 
@@ -164,21 +183,29 @@ def _crash3_stages(c: Mapping, units: str, e: float, tangents: list | None = Non
             outs, st, _fl = _kernels.run_batch(ks, args, n)
         else:
             jk = _kernels.JACOBIAN[name]
-            row = _kernels.run_one(jk, {k: float(np.ravel(v)[0]) for k, v in inputs.items()},
-                                   jk.outputs)
+            row = _kernels.run_one(jk, {k: float(np.ravel(v)[0]) for k, v in inputs.items()}, jk.outputs)
             st = np.array([row["status"]])
             outs = {o: np.array([row[o]]) for o in ks.outputs}
             for t in tan:
                 for o in ks.outputs:
-                    t[prefix + o] = sum(row.get(f"d_{o}__d_{x}", 0.0) * t.get(inputs_key[x], 0.0)
-                                        for x in ks.inputs)
+                    t[prefix + o] = sum(
+                        row.get(f"d_{o}__d_{x}", 0.0) * t.get(inputs_key[x], 0.0) for x in ks.inputs
+                    )
         np.copyto(status, st, where=status == 0)
         return outs
 
     for i, crush in enumerate(c["crush"], start=1):
         if crush is None:
-            vals.update({f"E{i}": 0.0, f"E_crush{i}": 0.0, f"rg{i}": math.inf, f"h{i}": 0.0,
-                         f"alpha{i}": 0.0, f"m{i}": math.inf})
+            vals.update(
+                {
+                    f"E{i}": 0.0,
+                    f"E_crush{i}": 0.0,
+                    f"rg{i}": math.inf,
+                    f"h{i}": 0.0,
+                    f"alpha{i}": 0.0,
+                    f"m{i}": math.inf,
+                }
+            )
             continue
         depths = sum(1 for k in crush if k.startswith("C") and k[1:].isdigit())
         inputs_key = {k: f"crush{i}.{k}" for k in crush}
@@ -195,8 +222,12 @@ def _crash3_stages(c: Mapping, units: str, e: float, tangents: list | None = Non
             _alias(tan, f"rg{i}", f"crush{i}.radius_of_gyration")
         elif np.all(np.isfinite(c[f"I{i}"])):
             inputs_key = {"mass": f"m{i}", "inertia": f"I{i}"}
-            vals[f"rg{i}"] = stage("crash3_radius_of_gyration", _kernels.CRASH3_RADIUS_OF_GYRATION,
-                                   {"mass": c[f"m{i}"], "inertia": c[f"I{i}"]}, f"rg{i}.")["rg"]
+            vals[f"rg{i}"] = stage(
+                "crash3_radius_of_gyration",
+                _kernels.CRASH3_RADIUS_OF_GYRATION,
+                {"mass": c[f"m{i}"], "inertia": c[f"I{i}"]},
+                f"rg{i}.",
+            )["rg"]
             _alias(tan, f"rg{i}", f"rg{i}.rg")
         else:
             vals[f"rg{i}"] = math.inf
@@ -209,15 +240,18 @@ def _crash3_stages(c: Mapping, units: str, e: float, tangents: list | None = Non
                 for t in tan:
                     t[f"theta{i}"] = t.get("gamma", 0.0) + t.get(f"crush{i}.alpha", 0.0)
             inputs_key = {"rx": f"r{i}x", "ry": f"r{i}y", "theta": f"theta{i}"}
-            vals[f"h{i}"] = stage("crash3_moment_arm", _kernels.CRASH3_MOMENT_ARM,
-                                  {"rx": c[f"r{i}x"], "ry": c[f"r{i}y"], "theta": theta}, f"h{i}.")["h"]
+            vals[f"h{i}"] = stage(
+                "crash3_moment_arm",
+                _kernels.CRASH3_MOMENT_ARM,
+                {"rx": c[f"r{i}x"], "ry": c[f"r{i}y"], "theta": theta},
+                f"h{i}.",
+            )["h"]
             _alias(tan, f"h{i}", f"h{i}.h")
     vals["E"] = vals["E1"] + vals["E2"]
     if tan is not None:
         for t in tan:
             t["E"] = t.get("E1", 0.0) + t.get("E2", 0.0)
-    inputs_key = {k: k for k in ("m1", "m2", "rg1", "rg2", "h1", "h2", "E", "e", "gamma",
-                                 "alpha1", "alpha2")}
+    inputs_key = {k: k for k in ("m1", "m2", "rg1", "rg2", "h1", "h2", "E", "e", "gamma", "alpha1", "alpha2")}
     dv_inputs = {k: vals[k] if k in vals else c[k] for k in inputs_key if k != "e"}
     dv_inputs["e"] = e
     vals.update(stage("crash3_delta_v", _kernels.CRASH3_DELTA_V, dv_inputs, "dv."))
@@ -238,10 +272,18 @@ def _crash3_outputs(c: Mapping, v: Mapping) -> dict:
     out = {}
     for i in (1, 2):
         p = f"vehicles[{i - 1}]"
-        out.update({f"{p}.crush_energy": v[f"E{i}"], f"{p}.crush_energy_uncorrected": v[f"E_crush{i}"],
-                    f"{p}.effective_mass_factor": v[f"mass_factor{i}"], f"{p}.moment_arm": v[f"h{i}"],
-                    f"{p}.delta_v[0]": v[f"dV{i}x"], f"{p}.delta_v[1]": v[f"dV{i}y"],
-                    f"{p}.delta_v_magnitude": v[f"dV{i}"], f"{p}.pdof": v[f"alpha{i}"] * DEGREES})
+        out.update(
+            {
+                f"{p}.crush_energy": v[f"E{i}"],
+                f"{p}.crush_energy_uncorrected": v[f"E_crush{i}"],
+                f"{p}.effective_mass_factor": v[f"mass_factor{i}"],
+                f"{p}.moment_arm": v[f"h{i}"],
+                f"{p}.delta_v[0]": v[f"dV{i}x"],
+                f"{p}.delta_v[1]": v[f"dV{i}y"],
+                f"{p}.delta_v_magnitude": v[f"dV{i}"],
+                f"{p}.pdof": v[f"alpha{i}"] * DEGREES,
+            }
+        )
         if f"dV{i}_eff" in v:  # EDCRASH's effective-mass delta-V, where the kernel has it
             out[f"{p}.delta_v_effective_mass"] = v[f"dV{i}_eff"]
     out["energy_total"], out["impulse"] = v["E"], v["P"]
@@ -250,6 +292,7 @@ def _crash3_outputs(c: Mapping, v: Mapping) -> dict:
 
 def _crash3_command(units: str, e: float) -> Command:
     """CRASH3 as a chain of kernels; its gradients chain their exact Jacobians."""
+
     def run(c):
         vals, status, _ = _crash3_stages(c, units, e)
         return vals, status, np.zeros_like(status)
@@ -262,8 +305,9 @@ def _crash3_command(units: str, e: float) -> Command:
         grads = {path: np.zeros(len(dcols)) for path in values}
         for j, t in enumerate(tan):
             h = COMPLEX_STEP
-            cplx = {k: complex(np.ravel(x)[0] if np.ndim(x) else x, h * t.get(k, 0.0))
-                    for k, x in vals.items()}
+            cplx = {
+                k: complex(np.ravel(x)[0] if np.ndim(x) else x, h * t.get(k, 0.0)) for k, x in vals.items()
+            }
             for path, y in _crash3_outputs(base, cplx).items():
                 grads[path][j] = np.imag(y) / h
         return grads
@@ -271,8 +315,7 @@ def _crash3_command(units: str, e: float) -> Command:
     return Command("crash3", run, lambda c: (None, {}), _crash3_outputs, gradients)
 
 
-def command_for(command: str, model: str = "rigid", units: str = "SI",
-                restitution: float = 0.0) -> Command:
+def command_for(command: str, model: str = "rigid", units: str = "SI", restitution: float = 0.0) -> Command:
     """The Command of ``solve`` (any model), ``invert`` (rigid, particle),
     ``reconstruct`` or ``crash3`` (scene units and CRASH3's restitution)."""
     if command == "crash3":

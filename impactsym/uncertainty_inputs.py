@@ -56,8 +56,9 @@ class Input:
             return p[0] + (p[1] - p[0]) * u
         a, c, b = p
         left = (c - a) / (b - a)
-        return np.where(u < left, a + np.sqrt(u * (b - a) * (c - a)),
-                        b - np.sqrt((1.0 - u) * (b - a) * (b - c)))
+        return np.where(
+            u < left, a + np.sqrt(u * (b - a) * (c - a)), b - np.sqrt((1.0 - u) * (b - a) * (b - c))
+        )
 
 
 def _normal_cdf(z):

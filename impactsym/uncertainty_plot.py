@@ -9,9 +9,16 @@ from __future__ import annotations
 import numpy as np
 
 #: Outputs drawn first when present (the answers a reconstructionist reports).
-MAIN = ("vehicles[0].speed", "vehicles[1].speed", "vehicles[0].delta_v_magnitude",
-        "vehicles[1].delta_v_magnitude", "energy_loss.total", "energy_total",
-        "vehicles[0].crush_energy", "vehicles[1].crush_energy")
+MAIN = (
+    "vehicles[0].speed",
+    "vehicles[1].speed",
+    "vehicles[0].delta_v_magnitude",
+    "vehicles[1].delta_v_magnitude",
+    "energy_loss.total",
+    "energy_total",
+    "vehicles[0].crush_energy",
+    "vehicles[1].crush_energy",
+)
 
 
 def main_outputs(result, count: int = 4) -> list[str]:
@@ -40,8 +47,7 @@ def save_uncertainty_plot(result, path, bins: int = 60) -> None:
         ax.set_yticks([])
     axes[0].legend(fontsize=8)
     _tornado(axes[-1], result, outputs[0] if outputs else next(iter(result.outputs)))
-    fig.suptitle(f"{result.command}: {result.accepted} of {result.n_draws} draws accepted",
-                 fontsize=10)
+    fig.suptitle(f"{result.command}: {result.accepted} of {result.n_draws} draws accepted", fontsize=10)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -57,5 +63,7 @@ def _tornado(ax, result, output: str, count: int = 8) -> None:
     ax.set_title(f"budget: {output}", fontsize=9)
     if not shares:
         ax.text(0.5, 0.5, "no linear budget", ha="center", transform=ax.transAxes)
-    ax.set_xlim(min(0.0, *(s for _, s in shares)) if shares else 0.0,
-                max(1.0, *(s for _, s in shares)) if shares else 1.0)
+    ax.set_xlim(
+        min(0.0, *(s for _, s in shares)) if shares else 0.0,
+        max(1.0, *(s for _, s in shares)) if shares else 1.0,
+    )

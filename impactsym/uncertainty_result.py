@@ -94,6 +94,7 @@ class Stats:
 
 # --------------------------------------------------------------------------- the result
 
+
 @dataclass
 class Uncertainty:
     """The uncertainty of a command's answers (scene units).
@@ -132,22 +133,32 @@ class Uncertainty:
         rows = {}
         for path, o in self.outputs.items():
             top = sorted(self.budget.get(path, {}).items(), key=lambda kv: -abs(kv[1]))[:3]
-            rows[path] = {**{k: o[k] for k in ("nominal", "mean", "sd", "p5", "p50", "p95",
-                                              "sd_linear")},
-                          "budget": ", ".join(f"{name} {share:.0%}" for name, share in top)}
+            rows[path] = {
+                **{k: o[k] for k in ("nominal", "mean", "sd", "p5", "p50", "p95", "sd_linear")},
+                "budget": ", ".join(f"{name} {share:.0%}" for name, share in top),
+            }
         return pd.DataFrame.from_dict(rows, orient="index")
 
     def to_json_dict(self) -> dict:
         """The ``"uncertainty"`` object of conventions.md (non-finite → null)."""
+
         def num(x):
             return float(x) if x is not None and math.isfinite(x) else None
 
-        outputs = {path: {**{k: num(o[k]) for k in ("nominal", "mean", "sd", "p5", "p50", "p95",
-                                                   "sd_linear")},
-                          "budget": {k: num(v) for k, v in self.budget.get(path, {}).items()}}
-                   for path, o in self.outputs.items()}
-        out = {"draws": self.n_draws, "accepted": self.accepted, "rejected": dict(self.rejected),
-               "inputs": list(self.inputs), "outputs": outputs}
+        outputs = {
+            path: {
+                **{k: num(o[k]) for k in ("nominal", "mean", "sd", "p5", "p50", "p95", "sd_linear")},
+                "budget": {k: num(v) for k, v in self.budget.get(path, {}).items()},
+            }
+            for path, o in self.outputs.items()
+        }
+        out = {
+            "draws": self.n_draws,
+            "accepted": self.accepted,
+            "rejected": dict(self.rejected),
+            "inputs": list(self.inputs),
+            "outputs": outputs,
+        }
         if self.notes:
             out["notes"] = list(self.notes)
         if self.sobol is not None:
@@ -156,19 +167,25 @@ class Uncertainty:
 
     def table(self, units: str | None = None) -> str:
         """Nominal, mean, 90 % interval and the three largest budget shares per output."""
-        lines = [f"uncertainty ({self.command}): {self.n_draws} draws, {self.accepted} accepted"
-                 + (f", seed {self.seed}" if self.seed is not None else "")]
+        lines = [
+            f"uncertainty ({self.command}): {self.n_draws} draws, {self.accepted} accepted"
+            + (f", seed {self.seed}" if self.seed is not None else "")
+        ]
         if self.rejected:
             lines.append("rejected: " + ", ".join(f"{k} {v}" for k, v in self.rejected.items()))
         lines += [f"note: {n}" for n in self.notes]
         width = max(len(p) for p in self.outputs) + 2
-        lines += ["", (f"{'output':<{width}}{'nominal':>12}{'mean':>12}{'90 % interval':>26}"
-                       "  largest budget shares")]
+        lines += [
+            "",
+            (f"{'output':<{width}}{'nominal':>12}{'mean':>12}{'90 % interval':>26}  largest budget shares"),
+        ]
         for path, o in self.outputs.items():
             top = sorted(self.budget.get(path, {}).items(), key=lambda kv: -abs(kv[1]))[:3]
             interval = f"[{_cell(o['p5'])}, {_cell(o['p95'])}]"
-            lines.append(f"{path:<{width}}{_cell(o['nominal']):>12}{_cell(o['mean']):>12}"
-                         f"{interval:>26}  " + ", ".join(f"{n} {s:.0%}" for n, s in top))
+            lines.append(
+                f"{path:<{width}}{_cell(o['nominal']):>12}{_cell(o['mean']):>12}"
+                f"{interval:>26}  " + ", ".join(f"{n} {s:.0%}" for n, s in top)
+            )
         return "\n".join(lines)
 
 

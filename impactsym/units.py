@@ -58,29 +58,50 @@ class Dimension:
 DIMENSIONS = {
     "mass": Dimension("a mass", "kg, lb, slug", "[mass]"),
     "force": Dimension("a force (a weight)", "N, lbf, kN", "[force]"),
-    "inertia": Dimension("a yaw inertia (mass × length²)", "kg*m**2, slug*ft**2, lbf*ft*s**2",
-                         "[mass]*[length]**2"),
+    "inertia": Dimension(
+        "a yaw inertia (mass × length²)", "kg*m**2, slug*ft**2, lbf*ft*s**2", "[mass]*[length]**2"
+    ),
     "length": Dimension("a length", "m, ft, in", "[length]"),
     "speed": Dimension("a speed", "m/s, ft/s, mph, km/h", "[length]/[time]"),
     "angle": Dimension("an angle", "deg, rad", None),
     "rate": Dimension("a yaw rate", "rad/s, deg/s", None),
     "number": Dimension("a plain number", "no unit, or %", None),
-    "stiffness_A": Dimension("a force per unit width (CRASH3 A)", "lbf/in, N/m, N/cm",
-                             "[force]/[length]"),
-    "stiffness_B": Dimension("a force per unit area (CRASH3 B)", "lbf/in**2, N/m**2, N/cm**2",
-                             "[force]/[length]**2"),
+    "stiffness_A": Dimension("a force per unit width (CRASH3 A)", "lbf/in, N/m, N/cm", "[force]/[length]"),
+    "stiffness_B": Dimension(
+        "a force per unit area (CRASH3 B)", "lbf/in**2, N/m**2, N/cm**2", "[force]/[length]**2"
+    ),
     "crush_length": Dimension("a length", "in, cm, m", "[length]"),
 }
 
 #: The unit of each dimension in each system: what a bare number means.
 #: CRASH3 crush inputs keep CRASH3's own units (lb/in, lb/in², in) in US scenes.
 SCENE_UNITS = {
-    "SI": {"mass": "kg", "force": "N", "inertia": "kg*m**2", "length": "m", "speed": "m/s",
-           "angle": "deg", "rate": "rad/s", "number": "", "stiffness_A": "N/m",
-           "stiffness_B": "N/m**2", "crush_length": "m"},
-    "US": {"mass": "slug", "force": "lbf", "inertia": "slug*ft**2", "length": "ft",
-           "speed": "ft/s", "angle": "deg", "rate": "rad/s", "number": "",
-           "stiffness_A": "lbf/in", "stiffness_B": "lbf/in**2", "crush_length": "in"},
+    "SI": {
+        "mass": "kg",
+        "force": "N",
+        "inertia": "kg*m**2",
+        "length": "m",
+        "speed": "m/s",
+        "angle": "deg",
+        "rate": "rad/s",
+        "number": "",
+        "stiffness_A": "N/m",
+        "stiffness_B": "N/m**2",
+        "crush_length": "m",
+    },
+    "US": {
+        "mass": "slug",
+        "force": "lbf",
+        "inertia": "slug*ft**2",
+        "length": "ft",
+        "speed": "ft/s",
+        "angle": "deg",
+        "rate": "rad/s",
+        "number": "",
+        "stiffness_A": "lbf/in",
+        "stiffness_B": "lbf/in**2",
+        "crush_length": "in",
+    },
 }
 
 
@@ -124,8 +145,9 @@ def _parse(text: str):
     try:
         return ureg.Quantity(ureg(text))
     except Exception as exc:  # noqa: BLE001 - pint raises many types (UndefinedUnitError, SyntaxError, ...)
-        raise ValueError(f"must be a finite number or a number with a unit pint understands, "
-                         f"got {text!r} ({_reason(exc)})") from None
+        raise ValueError(
+            f"must be a finite number or a number with a unit pint understands, got {text!r} ({_reason(exc)})"
+        ) from None
 
 
 def _reason(exc: Exception) -> str:

@@ -59,21 +59,32 @@ __all__ = [
 ]
 
 DATA_DIR = Path(__file__).resolve().parent.parent / "validation"
-G_FT = 32.174           # ft/s², standard gravity: weight [lb] → mass [slug]
-G_ROSE = 32.2           # ft/s²: Rose et al. convert weights with 32.2 (README)
-MPH = 5280.0 / 3600.0   # ft/s per mph
-FUSION_WEIGHT, FUSION_INERTIA = 3574.2, 2336.3   # lb, slug·ft² (the one car with data)
-MEASURED_VERSIONS = {"untransformed": "dv_measured_untransformed",
-                     "Brach & Smith 2002": "dv_measured_brach_smith_2002",
-                     "McHenry 1997": "dv_measured_mchenry_1997"}
+G_FT = 32.174  # ft/s², standard gravity: weight [lb] → mass [slug]
+G_ROSE = 32.2  # ft/s²: Rose et al. convert weights with 32.2 (README)
+MPH = 5280.0 / 3600.0  # ft/s per mph
+FUSION_WEIGHT, FUSION_INERTIA = 3574.2, 2336.3  # lb, slug·ft² (the one car with data)
+MEASURED_VERSIONS = {
+    "untransformed": "dv_measured_untransformed",
+    "Brach & Smith 2002": "dv_measured_brach_smith_2002",
+    "McHenry 1997": "dv_measured_mchenry_1997",
+}
 # Neades, thesis Table 5.7: per test.vehicle, the change to every crush depth
 # [cm], to the damage offset D [cm], or the damage width L [cm] (README).
-NEADES_DEPTH = {"1.2": -10, "2.2": -15, "3.1": 5, "4.2": -15, "5.2": -20, "6.2": -15, "7.2": -20,
-                "9.1": -10, "10.2": 10}
+NEADES_DEPTH = {
+    "1.2": -10,
+    "2.2": -15,
+    "3.1": 5,
+    "4.2": -15,
+    "5.2": -20,
+    "6.2": -15,
+    "7.2": -20,
+    "9.1": -10,
+    "10.2": 10,
+}
 NEADES_OFFSET = {"3.2": -50}
 NEADES_WIDTH = {"12.1": 140, "12.2": 140}
 IMPLAUSIBLE = {"7.2": "mass 771 kg is implausible for that car (README); kept as published"}
-SHIFT_M = 0.2           # m: the impact-centre shift of the RICSAC sensitivity study
+SHIFT_M = 0.2  # m: the impact-centre shift of the RICSAC sensitivity study
 ASSUMPTIONS = {
     "ricsac_crash3": (
         "Damaged faces from the configuration (vehicle 1 front; vehicle 2 side, rear or front). "
@@ -84,26 +95,30 @@ ASSUMPTIONS = {
         "Test 8.1's profile '7 9 0 0 0 0' is the 2-point profile 6.9 -> 9.1 cm. Neades' "
         "adjustments: every depth shifted (clipped at 0), test 3.2's offset D - 50 cm, test 12's "
         "L = 140 cm, and his adjusted PDOFs. CRASH3 options: restitution 0, energy dissipated, "
-        "CRASH3 correction capped at 45 degrees (EDCRASH). Delta-V is the CG delta-V."),
+        "CRASH3 correction capped at 45 degrees (EDCRASH). Delta-V is the CG delta-V."
+    ),
     "ricsac_pim": (
         "Rigid model, Brach's 1987 e, mu = mu_c (Brach's fit is critical in every test), e_m = 1. "
         "Pre-impact velocities and Gamma from Vossou & Koulocheris 2018; headings = direction of "
         "travel (struck car of tests 3-5, stopped: 170 degrees). Impact centre APPROXIMATED: "
         "each vehicle's damage centre (as for the CRASH3 moment arm), i.e. the two damage "
-        "centres are assumed to touch. Sensitivity: each centre moved +/- 0.2 m along its face."),
+        "centres are assumed to touch. Sensitivity: each centre moved +/- 0.2 m along its face."
+    ),
     "iihs_barrier": (
         "Car into a fixed barrier (m = I = inf). phi counter-clockwise from forward (left front "
         "corner), Gamma = the seed's angle of the impact surface from the y axis = normal_angle "
         "(notebooks/06_models.ipynb). mu = (percent/100) mu_c, e_m = 1. Inertia: only the Ford "
         "Fusion's is known (3574.2 lb, 2336.3 slug ft^2); into a fixed barrier delta-V depends "
         "on k^2 = I/m only, and every car is given the Fusion's k = 4.59 ft (an assumption). "
-        "CF11006 is the source's outlier: shown, left out of the statistics."),
+        "CF11006 is the source's outlier: shown, left out of the statistics."
+    ),
     "nhtsa": (
         "Published inputs: weight / 32.2 ft/s^2, yaw inertia in slug ft^2, impact centre at d "
         "and angle from the heading, Gamma as printed, its sense chosen so that n points from "
         "vehicle 1's CG towards vehicle 2's, mu = mu_c, e_m = 1. NHTSA's frame is left-handed: "
         "every angle is read in one frame, which mirrors the scene (magnitudes unchanged); "
-        "yaw rates are compared unsigned, as printed. Test 4474: e = 0.150 (README)."),
+        "yaw rates are compared unsigned, as printed. Test 4474: e = 0.150 (README)."
+    ),
 }
 
 
@@ -115,7 +130,7 @@ class Comparison:
     model: str
     quantity: str
     reference: str
-    rows: tuple[tuple[str, float, float], ...]   # (label, model value, reference value)
+    rows: tuple[tuple[str, float, float], ...]  # (label, model value, reference value)
 
     @property
     def errors(self) -> list[float]:
@@ -140,11 +155,16 @@ def stats(errors: list[float]) -> dict[str, Any]:
     """n, median |error|, worst |error| and median signed error (bias), in percent."""
     if not errors:
         return {"n": 0, "median": math.nan, "worst": math.nan, "bias": math.nan}
-    return {"n": len(errors), "median": statistics.median(abs(x) for x in errors),
-            "worst": max(abs(x) for x in errors), "bias": statistics.median(errors)}
+    return {
+        "n": len(errors),
+        "median": statistics.median(abs(x) for x in errors),
+        "worst": max(abs(x) for x in errors),
+        "bias": statistics.median(errors),
+    }
 
 
 # ---------------------------------------------------------------- data
+
 
 @cache
 def _read(name: str, data_dir: Path = DATA_DIR) -> tuple[dict[str, str], ...]:
@@ -165,6 +185,7 @@ def _wrap(angle: float) -> float:
 
 
 # ---------------------------------------------------------------- RICSAC: CRASH3
+
 
 def _faces(configuration: str) -> tuple[str, str]:
     """The damaged faces of vehicles 1 and 2 from a RICSAC configuration."""
@@ -204,7 +225,7 @@ def _moment_arm(centre, pdof: float) -> float:
 def _profile(vehicle: Mapping[str, str], key: str, adjusted: bool):
     """(depths [cm], width L [cm], offset D [cm]) as published or as Neades adjusted them."""
     depths = [_num(vehicle[f"c{i}_cm"]) for i in range(1, 7)]
-    if key == "8.1":            # "7 9 0 0 0 0": a 2-point profile (README)
+    if key == "8.1":  # "7 9 0 0 0 0": a 2-point profile (README)
         depths = [6.9, 9.1]
     width, offset = _num(vehicle["L_cm"]), _num(vehicle["D_cm"])
     if adjusted:
@@ -220,10 +241,15 @@ def _crash3_vehicle(key: str, face: str, pdof: float, adjusted: bool, arm: bool 
     depths, width, offset = _profile(vehicle, key, adjusted)
     mass, inertia = _num(vehicle["mass_kg"]), _num(vehicle["yaw_inertia_kgm2"])
     h = _moment_arm(_damage_centre(face, vehicle, offset, pdof), pdof) if arm else 0.0
-    crush = {"A": _num(vehicle["A_N_per_cm"]) * 100.0, "B": _num(vehicle["B_N_per_cm2"]) * 1e4,
-             "width": width / 100.0, "depths": [c / 100.0 for c in depths],
-             "pdof": _alpha(face, pdof), "moment_arm": h,
-             "radius_of_gyration": math.sqrt(inertia / mass)}
+    crush = {
+        "A": _num(vehicle["A_N_per_cm"]) * 100.0,
+        "B": _num(vehicle["B_N_per_cm2"]) * 1e4,
+        "width": width / 100.0,
+        "depths": [c / 100.0 for c in depths],
+        "pdof": _alpha(face, pdof),
+        "moment_arm": h,
+        "radius_of_gyration": math.sqrt(inertia / mass),
+    }
     return {"name": key, "mass": mass, "crush": crush}
 
 
@@ -243,8 +269,10 @@ def _crash3_test(test: int, adjusted: bool, correction: str = "crash3", arm: boo
     faces = _faces(row["configuration"])
     kind = "adjusted" if adjusted else "original"
     pdofs = [_num(row[f"pdof_v{i}_{kind}_deg"]) for i in (1, 2)]
-    scene = {"units": "SI", "vehicles": [
-        _crash3_vehicle(f"{test}.{i + 1}", faces[i], pdofs[i], adjusted, arm) for i in range(2)]}
+    scene = {
+        "units": "SI",
+        "vehicles": [_crash3_vehicle(f"{test}.{i + 1}", faces[i], pdofs[i], adjusted, arm) for i in range(2)],
+    }
     return crash3(scene, restitution=0.0, energy="dissipated", correction=correction), faces, pdofs
 
 
@@ -257,24 +285,33 @@ def ricsac_crash3(adjusted: bool, arm: bool = True) -> list[dict[str, Any]]:
         data = _tests()[test]
         for i, vehicle in enumerate(result.vehicles):
             key = f"{test}.{i + 1}"
-            rows.append({
-                "vehicle": key, "face": faces[i], "pdof": pdofs[i],
-                "alpha": _alpha(faces[i], pdofs[i]),
-                "capped": any(f"vehicles[{i}].crush.pdof" in w for w in result.warnings),
-                "energy_J": vehicle.crush_energy, "gamma": vehicle.mass_factor,
-                "dv": vehicle.delta_v_magnitude, "dv_eff": vehicle.delta_v_effective_mass,
-                **{name: _num(data[f"{col}_v{i + 1}_mps"]) for name, col in MEASURED_VERSIONS.items()},
-                "neades_raw_crash": _num(data[f"dv_crash_raw_v{i + 1}_mps"]),
-                "note": IMPLAUSIBLE.get(key, ""),
-            })
+            rows.append(
+                {
+                    "vehicle": key,
+                    "face": faces[i],
+                    "pdof": pdofs[i],
+                    "alpha": _alpha(faces[i], pdofs[i]),
+                    "capped": any(f"vehicles[{i}].crush.pdof" in w for w in result.warnings),
+                    "energy_J": vehicle.crush_energy,
+                    "gamma": vehicle.mass_factor,
+                    "dv": vehicle.delta_v_magnitude,
+                    "dv_eff": vehicle.delta_v_effective_mass,
+                    **{name: _num(data[f"{col}_v{i + 1}_mps"]) for name, col in MEASURED_VERSIONS.items()},
+                    "neades_raw_crash": _num(data[f"dv_crash_raw_v{i + 1}_mps"]),
+                    "note": IMPLAUSIBLE.get(key, ""),
+                }
+            )
     return rows
 
 
-FT_LB = 4.4482216152605 * 0.3048   # J per ft·lb
+FT_LB = 4.4482216152605 * 0.3048  # J per ft·lb
 
 
-ENERGY_REFERENCES = {"measured": "measured", "brach_pim": "Brach's PIM (SAE 871993)",
-                     "woolley_1985": "Woolley's CRASH3 (1985)"}
+ENERGY_REFERENCES = {
+    "measured": "measured",
+    "brach_pim": "Brach's PIM (SAE 871993)",
+    "woolley_1985": "Woolley's CRASH3 (1985)",
+}
 
 
 def ricsac_energy() -> list[dict[str, Any]]:
@@ -287,21 +324,29 @@ def ricsac_energy() -> list[dict[str, Any]]:
         if _num(data["energy_loss_measured_ftlb"]) is None:
             continue
         out = {"test": test}
-        for label, adjusted, correction in (("published", False, "crash3"),
-                                            ("published, woolley", False, "woolley"),
-                                            ("neades", True, "crash3")):
+        for label, adjusted, correction in (
+            ("published", False, "crash3"),
+            ("published, woolley", False, "woolley"),
+            ("neades", True, "crash3"),
+        ):
             out[label] = _crash3_test(test, adjusted, correction)[0].energy_total / FT_LB
-        out.update({"woolley_1985": _num(data["crash3_energy_woolley1985_ftlb"]),
-                    "brach_pim": _num(data["brach1987_energy_loss_ftlb"]),
-                    "measured": _num(data["energy_loss_measured_ftlb"]),
-                    "initial": _num(data["initial_energy_ftlb"])})
-        out["impossible"] = ", ".join(k for k in ("published", "published, woolley", "neades")
-                                      if out[k] > out["initial"])
+        out.update(
+            {
+                "woolley_1985": _num(data["crash3_energy_woolley1985_ftlb"]),
+                "brach_pim": _num(data["brach1987_energy_loss_ftlb"]),
+                "measured": _num(data["energy_loss_measured_ftlb"]),
+                "initial": _num(data["initial_energy_ftlb"]),
+            }
+        )
+        out["impossible"] = ", ".join(
+            k for k in ("published", "published, woolley", "neades") if out[k] > out["initial"]
+        )
         rows.append(out)
     return rows
 
 
 # ---------------------------------------------------------------- RICSAC: impulse-momentum
+
 
 @lru_cache(maxsize=1)
 def _vossou() -> dict[int, dict[str, str]]:
@@ -334,23 +379,40 @@ def _ricsac_pim_scene(test: int, shift: tuple[float, float] = (0.0, 0.0)) -> dic
         face = faces[i - 1]
         centre = list(_damage_centre(face, data, offset, pdof))
         centre[1 if face != "side" else 0] += 100.0 * shift[i - 1]
-        vehicles.append({"name": key, "mass": _num(data["mass_kg"]),
-                         "yaw_inertia": _num(data["yaw_inertia_kgm2"]), "velocity": [vx, vy],
-                         "yaw_rate": 0.0, "impact_point": _scene_point(centre, heading)})
+        vehicles.append(
+            {
+                "name": key,
+                "mass": _num(data["mass_kg"]),
+                "yaw_inertia": _num(data["yaw_inertia_kgm2"]),
+                "velocity": [vx, vy],
+                "yaw_rate": 0.0,
+                "impact_point": _scene_point(centre, heading),
+            }
+        )
     gamma = _num(v["Gamma_deg"])
     (r1x, r1y), (r2x, r2y) = vehicles[0]["impact_point"], vehicles[1]["impact_point"]
     n = (math.cos(math.radians(gamma)), math.sin(math.radians(gamma)))
     if n[0] * (r1x - r2x) + n[1] * (r1y - r2y) < 0.0:
         gamma += 180.0
-    return {"units": "SI", "model": "rigid", "vehicles": vehicles,
-            "impact": {"normal_angle": gamma, "restitution": _num(row["brach1987_e"]),
-                       "impulse_ratio": "critical", "moment_restitution": 1.0}}
+    return {
+        "units": "SI",
+        "model": "rigid",
+        "vehicles": vehicles,
+        "impact": {
+            "normal_angle": gamma,
+            "restitution": _num(row["brach1987_e"]),
+            "impulse_ratio": "critical",
+            "moment_restitution": 1.0,
+        },
+    }
 
 
 # The other impulse-momentum models of the seed on the same RICSAC scenes (via
 # impactsym.compare): the common velocity (Limpert = IMPAC, e = 0) and particles.
-OTHER_PIM_MODELS = {"limpert": "Limpert/IMPAC common velocity (approx. impact centre)",
-                    "particle": "particle (Brach's e, mu_c)"}
+OTHER_PIM_MODELS = {
+    "limpert": "Limpert/IMPAC common velocity (approx. impact centre)",
+    "particle": "particle (Brach's e, mu_c)",
+}
 
 
 def ricsac_pim() -> list[dict[str, Any]]:
@@ -373,14 +435,25 @@ def ricsac_pim() -> list[dict[str, Any]]:
             except SceneError:
                 spread = math.inf
                 continue
-            spread = max(spread, *(100.0 * abs(m.delta_v_magnitude / b.delta_v_magnitude - 1.0)
-                                   for m, b in zip(moved.vehicles, base.vehicles)))
-        out = {"test": test, "status": "solved", "flags": base.flags,
-               "mu_c": base.mu_c, "brach_mu": _num(row["brach1987_mu"]),
-               "energy_loss": base.TL / FT_LB, "brach_energy_loss": _num(row["brach1987_energy_loss_ftlb"]),
-               "measured_energy_loss": _num(row["energy_loss_measured_ftlb"]),
-               "brach_tangential": _num(row["brach1987_tangential_loss_ftlb"]),
-               "sensitivity_pct": spread}
+            spread = max(
+                spread,
+                *(
+                    100.0 * abs(m.delta_v_magnitude / b.delta_v_magnitude - 1.0)
+                    for m, b in zip(moved.vehicles, base.vehicles)
+                ),
+            )
+        out = {
+            "test": test,
+            "status": "solved",
+            "flags": base.flags,
+            "mu_c": base.mu_c,
+            "brach_mu": _num(row["brach1987_mu"]),
+            "energy_loss": base.TL / FT_LB,
+            "brach_energy_loss": _num(row["brach1987_energy_loss_ftlb"]),
+            "measured_energy_loss": _num(row["energy_loss_measured_ftlb"]),
+            "brach_tangential": _num(row["brach1987_tangential_loss_ftlb"]),
+            "sensitivity_pct": spread,
+        }
         others = {row.model: row for row in compare(_ricsac_pim_scene(test)).rows}
         for model in OTHER_PIM_MODELS:
             out[f"{model} energy_loss"] = others[model].energy["total"] / FT_LB
@@ -404,25 +477,45 @@ def ricsac_momentum() -> list[dict[str, Any]]:
         before = [sum(m[i] * _num(v[f"v{i + 1}{a}_mps"]) for i in range(2)) for a in "xy"]
         after = [sum(m[i] * _num(v[f"V{i + 1}{a}_mps"]) for i in range(2)) for a in "xy"]
         size = math.hypot(*before)
-        rows.append({"test": test, "x_pct": 100.0 * (after[0] - before[0]) / size,
-                     "y_pct": 100.0 * (after[1] - before[1]) / size})
+        rows.append(
+            {
+                "test": test,
+                "x_pct": 100.0 * (after[0] - before[0]) / size,
+                "y_pct": 100.0 * (after[1] - before[1]) / size,
+            }
+        )
     return rows
 
 
 # ---------------------------------------------------------------- IIHS barrier
+
 
 def _barrier_scene(row: Mapping[str, str], mu: float | str, k_scale: float = 1.0) -> dict:
     """The car (Fusion mass; yaw inertia scaled by k_scale² for a sensitivity
     study of the assumed radius of gyration) into the fixed barrier."""
     mass = FUSION_WEIGHT / G_FT
     d, phi = _num(row["d1_ft"]), math.radians(_num(row["phi_deg"]))
-    return {"units": "US", "model": "rigid", "vehicles": [
-        {"name": row["test_id"], "mass": mass, "yaw_inertia": FUSION_INERTIA * k_scale**2,
-         "velocity": [_num(row["v0_ftps"]), 0.0], "yaw_rate": 0.0,
-         "impact_point": [d * math.cos(phi), d * math.sin(phi)]},
-        {"name": "barrier", "fixed": True}],
-        "impact": {"normal_angle": _num(row["gamma_deg"]), "restitution": _num(row["e"]),
-                   "impulse_ratio": mu, "moment_restitution": 1.0}}
+    return {
+        "units": "US",
+        "model": "rigid",
+        "vehicles": [
+            {
+                "name": row["test_id"],
+                "mass": mass,
+                "yaw_inertia": FUSION_INERTIA * k_scale**2,
+                "velocity": [_num(row["v0_ftps"]), 0.0],
+                "yaw_rate": 0.0,
+                "impact_point": [d * math.cos(phi), d * math.sin(phi)],
+            },
+            {"name": "barrier", "fixed": True},
+        ],
+        "impact": {
+            "normal_angle": _num(row["gamma_deg"]),
+            "restitution": _num(row["e"]),
+            "impulse_ratio": mu,
+            "moment_restitution": 1.0,
+        },
+    }
 
 
 def iihs_barrier(k_scale: float = 1.0) -> list[dict[str, Any]]:
@@ -432,22 +525,33 @@ def iihs_barrier(k_scale: float = 1.0) -> list[dict[str, Any]]:
     rows = []
     for row in _read("iihs_small_overlap_barrier_brach2014"):
         critical = solve(_barrier_scene(row, "critical", k_scale))
-        result = solve(_barrier_scene(row, _num(row["mu_percent_of_critical"]) / 100.0 * critical.mu_c,
-                                      k_scale))
+        result = solve(
+            _barrier_scene(row, _num(row["mu_percent_of_critical"]) / 100.0 * critical.mu_c, k_scale)
+        )
         car = result.vehicles[0]
         dvx, dvy = car.velocity[0] - _num(row["v0_ftps"]), car.velocity[1]
-        rows.append({"test": row["test_id"], "vehicle": f"{row['model_year']} {row['vehicle']}",
-                     "kind": row["kind"], "outlier": "outlier" in row["kind"],
-                     "dv": math.hypot(dvx, dvy),
-                     "dv_measured": math.hypot(_num(row["dvx_ftps"]), _num(row["dvy_ftps"])),
-                     "dvx": -dvx, "dvx_measured": _num(row["dvx_ftps"]),
-                     "dvy": abs(dvy), "dvy_measured": _num(row["dvy_ftps"]),
-                     "yaw": math.degrees(car.yaw_rate), "yaw_measured": _num(row["omega_degps"]),
-                     "flags": result.flags})
+        rows.append(
+            {
+                "test": row["test_id"],
+                "vehicle": f"{row['model_year']} {row['vehicle']}",
+                "kind": row["kind"],
+                "outlier": "outlier" in row["kind"],
+                "dv": math.hypot(dvx, dvy),
+                "dv_measured": math.hypot(_num(row["dvx_ftps"]), _num(row["dvy_ftps"])),
+                "dvx": -dvx,
+                "dvx_measured": _num(row["dvx_ftps"]),
+                "dvy": abs(dvy),
+                "dvy_measured": _num(row["dvy_ftps"]),
+                "yaw": math.degrees(car.yaw_rate),
+                "yaw_measured": _num(row["omega_degps"]),
+                "flags": result.flags,
+            }
+        )
     return rows
 
 
 # ---------------------------------------------------------------- NHTSA (Rose 2006)
+
 
 def _nhtsa_scene(rows: list[Mapping[str, str]]) -> dict:
     vehicles = []
@@ -456,20 +560,35 @@ def _nhtsa_scene(rows: list[Mapping[str, str]]) -> dict:
         speed = _num(row["speed_mph"]) * MPH
         angle = math.radians(heading + _num(row["angle_heading_to_impact_line_deg"]))
         d = _num(row["d_cg_to_impact_ft"])
-        vehicles.append({"name": row["vehicle"], "mass": _num(row["weight_lb"]) / G_ROSE,
-                         "yaw_inertia": _num(row["yaw_inertia_lb_ft_s2"]),
-                         "velocity": [speed * math.cos(math.radians(heading)),
-                                      speed * math.sin(math.radians(heading))],
-                         "yaw_rate": math.radians(_num(row["yaw_rate_degps"])),
-                         "impact_point": [d * math.cos(angle), d * math.sin(angle)]})
+        vehicles.append(
+            {
+                "name": row["vehicle"],
+                "mass": _num(row["weight_lb"]) / G_ROSE,
+                "yaw_inertia": _num(row["yaw_inertia_lb_ft_s2"]),
+                "velocity": [
+                    speed * math.cos(math.radians(heading)),
+                    speed * math.sin(math.radians(heading)),
+                ],
+                "yaw_rate": math.radians(_num(row["yaw_rate_degps"])),
+                "impact_point": [d * math.cos(angle), d * math.sin(angle)],
+            }
+        )
     gamma = _num(rows[0]["normal_angle_deg"])
     (r1x, r1y), (r2x, r2y) = vehicles[0]["impact_point"], vehicles[1]["impact_point"]
     if math.cos(math.radians(gamma)) * (r1x - r2x) + math.sin(math.radians(gamma)) * (r1y - r2y) < 0:
         gamma += 180.0
     e = 0.150 if rows[0]["nhtsa_test"] == "4474" else _num(rows[0]["e"])
-    return {"units": "US", "model": "rigid", "vehicles": vehicles,
-            "impact": {"normal_angle": gamma, "restitution": e, "impulse_ratio": "critical",
-                       "moment_restitution": 1.0}}
+    return {
+        "units": "US",
+        "model": "rigid",
+        "vehicles": vehicles,
+        "impact": {
+            "normal_angle": gamma,
+            "restitution": e,
+            "impulse_ratio": "critical",
+            "moment_restitution": 1.0,
+        },
+    }
 
 
 def nhtsa() -> list[dict[str, Any]]:
@@ -483,26 +602,52 @@ def nhtsa() -> list[dict[str, Any]]:
     for test, rows in by_test.items():
         result = solve(_nhtsa_scene(rows))
         for row, vehicle in zip(rows, result.vehicles):
-            out.append({"test": test, "vehicle": row["vehicle"],
-                        "energy_loss": result.TL, "energy_loss_published": _num(row["published_energy_loss_ftlb"]),
-                        "normal_loss": result.TLn, "normal_loss_published": _num(row["published_normal_loss_ftlb"]),
-                        "tangential_loss": result.TLt,
-                        "tangential_loss_published": _num(row["published_tangential_loss_ftlb"]),
-                        "dv": vehicle.delta_v_magnitude / MPH, "dv_published": _num(row["published_dv_mph"]),
-                        "dv_measured": _num(row["measured_dv_mph"]),
-                        "yaw": abs(math.degrees(vehicle.yaw_rate)),
-                        "yaw_published": _num(row["published_final_yaw_rate_degps"]),
-                        "flags": result.flags})
+            out.append(
+                {
+                    "test": test,
+                    "vehicle": row["vehicle"],
+                    "energy_loss": result.TL,
+                    "energy_loss_published": _num(row["published_energy_loss_ftlb"]),
+                    "normal_loss": result.TLn,
+                    "normal_loss_published": _num(row["published_normal_loss_ftlb"]),
+                    "tangential_loss": result.TLt,
+                    "tangential_loss_published": _num(row["published_tangential_loss_ftlb"]),
+                    "dv": vehicle.delta_v_magnitude / MPH,
+                    "dv_published": _num(row["published_dv_mph"]),
+                    "dv_measured": _num(row["measured_dv_mph"]),
+                    "yaw": abs(math.degrees(vehicle.yaw_rate)),
+                    "yaw_published": _num(row["published_final_yaw_rate_degps"]),
+                    "flags": result.flags,
+                }
+            )
     return out
 
 
 # ---------------------------------------------------------------- the report
 
-def _compare(dataset: str, model: str, quantity: str, reference: str, rows, label, got, want,
-             keep: Callable[[dict], bool] = lambda r: True) -> Comparison:
-    return Comparison(dataset, model, quantity, reference,
-                      tuple((label(r), got(r), want(r)) for r in rows
-                            if keep(r) and want(r) is not None and got(r) is not None))
+
+def _compare(
+    dataset: str,
+    model: str,
+    quantity: str,
+    reference: str,
+    rows,
+    label,
+    got,
+    want,
+    keep: Callable[[dict], bool] = lambda r: True,
+) -> Comparison:
+    return Comparison(
+        dataset,
+        model,
+        quantity,
+        reference,
+        tuple(
+            (label(r), got(r), want(r))
+            for r in rows
+            if keep(r) and want(r) is not None and got(r) is not None
+        ),
+    )
 
 
 def report() -> list[Dataset]:
@@ -513,66 +658,151 @@ def report() -> list[Dataset]:
 def _ricsac() -> Dataset:
     ds = Dataset("ricsac", "RICSAC staged car-to-car crashes (12 tests, 24 vehicles)")
     published, adjusted, no_arm = ricsac_crash3(False), ricsac_crash3(True), ricsac_crash3(True, arm=False)
-    ds.tables.update({"crash3 published": published, "crash3 neades": adjusted,
-                      "crash3 neades, gamma = 1": no_arm})
+    ds.tables.update(
+        {"crash3 published": published, "crash3 neades": adjusted, "crash3 neades, gamma = 1": no_arm}
+    )
     vehicle = itemgetter("vehicle")
-    for label, rows in (("CRASH3 (published profiles)", published),
-                        ("CRASH3 (Neades' adjustments)", adjusted),
-                        ("CRASH3 (Neades, gamma = 1)", no_arm)):
+    for label, rows in (
+        ("CRASH3 (published profiles)", published),
+        ("CRASH3 (Neades' adjustments)", adjusted),
+        ("CRASH3 (Neades, gamma = 1)", no_arm),
+    ):
         for version in MEASURED_VERSIONS:
-            ds.comparisons.append(_compare("ricsac", label, "delta-V", f"measured, {version}", rows,
-                                           vehicle, lambda r: r["dv"], lambda r, v=version: r[v]))
-    ds.comparisons.append(_compare("ricsac", "CRASH3 (published profiles)", "delta-V",
-                                   "Neades' raw CRASH", published, vehicle, lambda r: r["dv"],
-                                   lambda r: r["neades_raw_crash"]))
+            ds.comparisons.append(
+                _compare(
+                    "ricsac",
+                    label,
+                    "delta-V",
+                    f"measured, {version}",
+                    rows,
+                    vehicle,
+                    lambda r: r["dv"],
+                    lambda r, v=version: r[v],
+                )
+            )
+    ds.comparisons.append(
+        _compare(
+            "ricsac",
+            "CRASH3 (published profiles)",
+            "delta-V",
+            "Neades' raw CRASH",
+            published,
+            vehicle,
+            lambda r: r["dv"],
+            lambda r: r["neades_raw_crash"],
+        )
+    )
     energy = ricsac_energy()
     ds.tables["energy"] = energy
-    ds.notes += [f"PHYSICALLY IMPOSSIBLE: test {r['test']}: the CRASH3 crush energy ({r['impossible']}) "
-                 f"exceeds the initial kinetic energy ({_fmt(r['initial'])} ft lb)"
-                 for r in energy if r["impossible"]]
+    ds.notes += [
+        f"PHYSICALLY IMPOSSIBLE: test {r['test']}: the CRASH3 crush energy ({r['impossible']}) "
+        f"exceeds the initial kinetic energy ({_fmt(r['initial'])} ft lb)"
+        for r in energy
+        if r["impossible"]
+    ]
+
     def test(r):
         return str(r["test"])
-    for label, key in (("CRASH3 (published profiles)", "published"),
-                       ("CRASH3 (published, Woolley)", "published, woolley"),
-                       ("CRASH3 (Neades' adjustments)", "neades")):
+
+    for label, key in (
+        ("CRASH3 (published profiles)", "published"),
+        ("CRASH3 (published, Woolley)", "published, woolley"),
+        ("CRASH3 (Neades' adjustments)", "neades"),
+    ):
         for ref, name in ENERGY_REFERENCES.items():
-            ds.comparisons.append(_compare("ricsac", label, "energy loss", name, energy, test,
-                                           lambda r, k=key: r[k], lambda r, f=ref: r[f]))
+            ds.comparisons.append(
+                _compare(
+                    "ricsac",
+                    label,
+                    "energy loss",
+                    name,
+                    energy,
+                    test,
+                    lambda r, k=key: r[k],
+                    lambda r, f=ref: r[f],
+                )
+            )
     pim = ricsac_pim()
     ds.tables["pim"] = pim
     solved = [r for r in pim if r["status"] == "solved"]
     for version in (*MEASURED_VERSIONS, "brach_pim_2002"):
-        pairs = [(f"{r['test']}.{i}", r[f"dv{i}"], r[f"dv{i} {version}"]) for r in solved for i in (1, 2)
-                 if r[f"dv{i} {version}"] is not None]
-        ds.comparisons.append(Comparison("ricsac", "rigid PIM (approx. impact centre)", "delta-V",
-                                         f"measured, {version}" if version in MEASURED_VERSIONS
-                                         else "Brach's PIM 2002", tuple(pairs)))
+        pairs = [
+            (f"{r['test']}.{i}", r[f"dv{i}"], r[f"dv{i} {version}"])
+            for r in solved
+            for i in (1, 2)
+            if r[f"dv{i} {version}"] is not None
+        ]
+        ds.comparisons.append(
+            Comparison(
+                "ricsac",
+                "rigid PIM (approx. impact centre)",
+                "delta-V",
+                f"measured, {version}" if version in MEASURED_VERSIONS else "Brach's PIM 2002",
+                tuple(pairs),
+            )
+        )
     for model, label in OTHER_PIM_MODELS.items():
-        pairs = [(f"{r['test']}.{i}", r[f"{model} dv{i}"], r[f"dv{i} Brach & Smith 2002"])
-                 for r in solved for i in (1, 2) if r[f"dv{i} Brach & Smith 2002"] is not None]
-        ds.comparisons.append(Comparison("ricsac", label, "delta-V", "measured, Brach & Smith 2002",
-                                         tuple(pairs)))
-        ds.comparisons.append(_compare("ricsac", label, "energy loss", "measured", solved, test,
-                                       lambda r, m=model: r[f"{m} energy_loss"],
-                                       lambda r: r["measured_energy_loss"]))
-    for ref, name in (("measured_energy_loss", "measured"),
-                      ("brach_energy_loss", ENERGY_REFERENCES["brach_pim"])):
-        ds.comparisons.append(_compare("ricsac", "rigid PIM (approx. impact centre)", "energy loss",
-                                       name, solved, test, lambda r: r["energy_loss"],
-                                       lambda r, f=ref: r[f]))
-    ds.notes += [f"Rigid PIM, test {r['test']}: flagged: " + "; ".join(describe_flags(r["flags"]))
-                 + (f" (Brach's own tangential loss for this test is {_fmt(r['brach_tangential'])} "
-                    "ft lb, also negative)" if r["brach_tangential"] < 0 else "")
-                 for r in solved if r["flags"]]
+        pairs = [
+            (f"{r['test']}.{i}", r[f"{model} dv{i}"], r[f"dv{i} Brach & Smith 2002"])
+            for r in solved
+            for i in (1, 2)
+            if r[f"dv{i} Brach & Smith 2002"] is not None
+        ]
+        ds.comparisons.append(
+            Comparison("ricsac", label, "delta-V", "measured, Brach & Smith 2002", tuple(pairs))
+        )
+        ds.comparisons.append(
+            _compare(
+                "ricsac",
+                label,
+                "energy loss",
+                "measured",
+                solved,
+                test,
+                lambda r, m=model: r[f"{m} energy_loss"],
+                lambda r: r["measured_energy_loss"],
+            )
+        )
+    for ref, name in (
+        ("measured_energy_loss", "measured"),
+        ("brach_energy_loss", ENERGY_REFERENCES["brach_pim"]),
+    ):
+        ds.comparisons.append(
+            _compare(
+                "ricsac",
+                "rigid PIM (approx. impact centre)",
+                "energy loss",
+                name,
+                solved,
+                test,
+                lambda r: r["energy_loss"],
+                lambda r, f=ref: r[f],
+            )
+        )
+    ds.notes += [
+        f"Rigid PIM, test {r['test']}: flagged: "
+        + "; ".join(describe_flags(r["flags"]))
+        + (
+            f" (Brach's own tangential loss for this test is {_fmt(r['brach_tangential'])} "
+            "ft lb, also negative)"
+            if r["brach_tangential"] < 0
+            else ""
+        )
+        for r in solved
+        if r["flags"]
+    ]
     ds.tables["momentum"] = ricsac_momentum()
     worst = max(ds.tables["momentum"], key=lambda r: abs(r["x_pct"]))
-    ds.notes += [ASSUMPTIONS["ricsac_crash3"], ASSUMPTIONS["ricsac_pim"],
-                 f"Vossou's measured separation velocities do not conserve momentum (worst: test "
-                 f"{worst['test']}, {worst['x_pct']:+.1f} % of the initial momentum in x; test 1 "
-                 "to 10 between 1 and 17 %): the post-impact data are contaminated, so no model is "
-                 "fitted or judged on them. Test 12's pre-impact v1y (-4.28 m/s) also looks "
-                 "suspect (the y balance is off by 76 %); the rigid PIM uses it as published.",
-                 IMPLAUSIBLE["7.2"]]
+    ds.notes += [
+        ASSUMPTIONS["ricsac_crash3"],
+        ASSUMPTIONS["ricsac_pim"],
+        f"Vossou's measured separation velocities do not conserve momentum (worst: test "
+        f"{worst['test']}, {worst['x_pct']:+.1f} % of the initial momentum in x; test 1 "
+        "to 10 between 1 and 17 %): the post-impact data are contaminated, so no model is "
+        "fitted or judged on them. Test 12's pre-impact v1y (-4.28 m/s) also looks "
+        "suspect (the y balance is off by 76 %); the rigid PIM uses it as published.",
+        IMPLAUSIBLE["7.2"],
+    ]
     return ds
 
 
@@ -580,27 +810,46 @@ def _iihs() -> Dataset:
     ds = Dataset("iihs", "IIHS small-overlap barrier tests (41, Brach et al. 2014 fits)")
     rows = iihs_barrier()
     ds.tables["barrier"] = rows
+
     def keep(r):
         return not r["outlier"]
 
     label = itemgetter("test")
-    for quantity, key in (("delta-V", "dv"), ("longitudinal delta-V", "dvx"),
-                          ("lateral delta-V", "dvy"), ("yaw-rate change", "yaw")):
-        ds.comparisons.append(_compare("iihs", "rigid PIM (Brach's fits)", quantity, "measured",
-                                       rows, label, lambda r, k=key: r[k],
-                                       lambda r, k=key: r[f"{k}_measured"], keep))
+    for quantity, key in (
+        ("delta-V", "dv"),
+        ("longitudinal delta-V", "dvx"),
+        ("lateral delta-V", "dvy"),
+        ("yaw-rate change", "yaw"),
+    ):
+        ds.comparisons.append(
+            _compare(
+                "iihs",
+                "rigid PIM (Brach's fits)",
+                quantity,
+                "measured",
+                rows,
+                label,
+                lambda r, k=key: r[k],
+                lambda r, k=key: r[f"{k}_measured"],
+                keep,
+            )
+        )
     for scale in (0.9, 1.1):
         moved = [r for r in iihs_barrier(scale) if not r["outlier"]]
         dv = stats([100.0 * (r["dv"] / r["dv_measured"] - 1.0) for r in moved])
         yaw = stats([100.0 * (r["yaw"] / r["yaw_measured"] - 1.0) for r in moved])
-        ds.notes.append(f"Sensitivity to the assumed k: with k x {scale:g} the median |error| is "
-                        f"{dv['median']:.1f} % for |delta-V| (worst {dv['worst']:.1f} %) and "
-                        f"{yaw['median']:.1f} % for the yaw-rate change (worst {yaw['worst']:.1f} %, "
-                        f"bias {yaw['bias']:+.1f} %).")
-    ds.notes += [ASSUMPTIONS["iihs_barrier"],
-                 "The 9 vehicle-to-vehicle tests are not run: the appendix gives no CG-to-impact "
-                 "distance d1 for them, nor the vehicles' relative position, so the impact centre "
-                 "cannot be formed without inventing it."]
+        ds.notes.append(
+            f"Sensitivity to the assumed k: with k x {scale:g} the median |error| is "
+            f"{dv['median']:.1f} % for |delta-V| (worst {dv['worst']:.1f} %) and "
+            f"{yaw['median']:.1f} % for the yaw-rate change (worst {yaw['worst']:.1f} %, "
+            f"bias {yaw['bias']:+.1f} %)."
+        )
+    ds.notes += [
+        ASSUMPTIONS["iihs_barrier"],
+        "The 9 vehicle-to-vehicle tests are not run: the appendix gives no CG-to-impact "
+        "distance d1 for them, nor the vehicles' relative position, so the impact centre "
+        "cannot be formed without inventing it.",
+    ]
     return ds
 
 
@@ -608,22 +857,60 @@ def _nhtsa() -> Dataset:
     ds = Dataset("nhtsa", "NHTSA car-to-SUV tests 4364, 4438, 4474 (Rose et al. 2006)")
     rows = nhtsa()
     ds.tables["nhtsa"] = rows
+
     def label(r):
         return f"{r['test']} {r['vehicle']}"
 
     per_test = [r for i, r in enumerate(rows) if i % 2 == 0]
-    for quantity, key in (("energy loss", "energy_loss"), ("normal energy loss", "normal_loss"),
-                          ("tangential energy loss", "tangential_loss")):
-        ds.comparisons.append(_compare("nhtsa", "rigid PIM", quantity, "published PIM", per_test,
-                                       lambda r: r["test"], lambda r, k=key: r[k],
-                                       lambda r, k=key: r[f"{k}_published"]))
+    for quantity, key in (
+        ("energy loss", "energy_loss"),
+        ("normal energy loss", "normal_loss"),
+        ("tangential energy loss", "tangential_loss"),
+    ):
+        ds.comparisons.append(
+            _compare(
+                "nhtsa",
+                "rigid PIM",
+                quantity,
+                "published PIM",
+                per_test,
+                lambda r: r["test"],
+                lambda r, k=key: r[k],
+                lambda r, k=key: r[f"{k}_published"],
+            )
+        )
     ds.comparisons += [
-        _compare("nhtsa", "rigid PIM", "delta-V", "published PIM", rows, label,
-                 lambda r: r["dv"], lambda r: r["dv_published"]),
-        _compare("nhtsa", "rigid PIM", "final yaw rate", "published PIM", rows, label,
-                 lambda r: r["yaw"], lambda r: r["yaw_published"]),
-        _compare("nhtsa", "rigid PIM", "delta-V", "measured", rows, label,
-                 lambda r: r["dv"], lambda r: r["dv_measured"])]
+        _compare(
+            "nhtsa",
+            "rigid PIM",
+            "delta-V",
+            "published PIM",
+            rows,
+            label,
+            lambda r: r["dv"],
+            lambda r: r["dv_published"],
+        ),
+        _compare(
+            "nhtsa",
+            "rigid PIM",
+            "final yaw rate",
+            "published PIM",
+            rows,
+            label,
+            lambda r: r["yaw"],
+            lambda r: r["yaw_published"],
+        ),
+        _compare(
+            "nhtsa",
+            "rigid PIM",
+            "delta-V",
+            "measured",
+            rows,
+            label,
+            lambda r: r["dv"],
+            lambda r: r["dv_measured"],
+        ),
+    ]
     ds.notes.append(ASSUMPTIONS["nhtsa"])
     return ds
 
@@ -632,30 +919,59 @@ def _nhtsa() -> Dataset:
 
 # Per dataset, the plots: (panel title, reference, [(model, quantity), ...]).
 PLOTS = {
-    "ricsac": [("delta-V [m/s] vs measured (Brach & Smith 2002)", "measured, Brach & Smith 2002",
-                [("CRASH3 (published profiles)", "delta-V"), ("CRASH3 (Neades' adjustments)", "delta-V"),
-                 ("rigid PIM (approx. impact centre)", "delta-V"),
-                 (OTHER_PIM_MODELS["limpert"], "delta-V")]),
-               ("energy loss [ft lb] vs measured", None,
-                [("CRASH3 (published profiles)", "energy loss", "measured"),
-                 ("CRASH3 (Neades' adjustments)", "energy loss", "measured"),
-                 ("rigid PIM (approx. impact centre)", "energy loss", "measured")])],
-    "iihs": [("delta-V [ft/s] vs measured", "measured", [("rigid PIM (Brach's fits)", "delta-V")]),
-             ("yaw-rate change [deg/s] vs measured", "measured",
-              [("rigid PIM (Brach's fits)", "yaw-rate change")])],
-    "nhtsa": [("delta-V [mph]", None, [("rigid PIM", "delta-V", "published PIM"),
-                                        ("rigid PIM", "delta-V", "measured")]),
-              ("final yaw rate [deg/s] vs published PIM", "published PIM",
-               [("rigid PIM", "final yaw rate")]),
-              ("energy loss [ft lb] vs published PIM", "published PIM",
-               [("rigid PIM", "energy loss"), ("rigid PIM", "normal energy loss"),
-                ("rigid PIM", "tangential energy loss")])],
+    "ricsac": [
+        (
+            "delta-V [m/s] vs measured (Brach & Smith 2002)",
+            "measured, Brach & Smith 2002",
+            [
+                ("CRASH3 (published profiles)", "delta-V"),
+                ("CRASH3 (Neades' adjustments)", "delta-V"),
+                ("rigid PIM (approx. impact centre)", "delta-V"),
+                (OTHER_PIM_MODELS["limpert"], "delta-V"),
+            ],
+        ),
+        (
+            "energy loss [ft lb] vs measured",
+            None,
+            [
+                ("CRASH3 (published profiles)", "energy loss", "measured"),
+                ("CRASH3 (Neades' adjustments)", "energy loss", "measured"),
+                ("rigid PIM (approx. impact centre)", "energy loss", "measured"),
+            ],
+        ),
+    ],
+    "iihs": [
+        ("delta-V [ft/s] vs measured", "measured", [("rigid PIM (Brach's fits)", "delta-V")]),
+        (
+            "yaw-rate change [deg/s] vs measured",
+            "measured",
+            [("rigid PIM (Brach's fits)", "yaw-rate change")],
+        ),
+    ],
+    "nhtsa": [
+        (
+            "delta-V [mph]",
+            None,
+            [("rigid PIM", "delta-V", "published PIM"), ("rigid PIM", "delta-V", "measured")],
+        ),
+        ("final yaw rate [deg/s] vs published PIM", "published PIM", [("rigid PIM", "final yaw rate")]),
+        (
+            "energy loss [ft lb] vs published PIM",
+            "published PIM",
+            [
+                ("rigid PIM", "energy loss"),
+                ("rigid PIM", "normal energy loss"),
+                ("rigid PIM", "tangential energy loss"),
+            ],
+        ),
+    ],
 }
 
 
 def _find(ds: Dataset, model: str, quantity: str, reference: str) -> Comparison:
-    return next(c for c in ds.comparisons
-                if (c.model, c.quantity, c.reference) == (model, quantity, reference))
+    return next(
+        c for c in ds.comparisons if (c.model, c.quantity, c.reference) == (model, quantity, reference)
+    )
 
 
 def plot(datasets: list[Dataset], directory: Path | str) -> list[Path]:
@@ -679,10 +995,14 @@ def plot(datasets: list[Dataset], directory: Path | str) -> list[Path]:
             mixed_r = len({c.reference for c in comps}) > 1
             for comp in comps:
                 xs, ys = [r for _, _, r in comp.rows], [m for _, m, _ in comp.rows]
-                label = comp.model + (f", {comp.quantity}" if mixed_q else "") \
+                label = (
+                    comp.model
+                    + (f", {comp.quantity}" if mixed_q else "")
                     + (f" vs {comp.reference}" if mixed_r else "")
-                ax.scatter(xs, ys, s=22, alpha=0.8,
-                           label=f"{label} (median |err| {comp.stats()['median']:.1f} %)")
+                )
+                ax.scatter(
+                    xs, ys, s=22, alpha=0.8, label=f"{label} (median |err| {comp.stats()['median']:.1f} %)"
+                )
                 top = max(top, *xs, *ys)
             ax.ticklabel_format(style="sci", scilimits=(-3, 4))
             ax.plot([0, top * 1.05], [0, top * 1.05], "k--", lw=1, label="1:1")
@@ -719,81 +1039,194 @@ def _table(rows: list[dict], columns: list[tuple[str, str]]) -> list[str]:
     return lines
 
 
-STATS_COLUMNS = [("model", "model"), ("quantity", "quantity"), ("reference", "reference"),
-                 ("n", "n"), ("median abs err %", "median"), ("worst abs err %", "worst"),
-                 ("median signed err %", "bias")]
+STATS_COLUMNS = [
+    ("model", "model"),
+    ("quantity", "quantity"),
+    ("reference", "reference"),
+    ("n", "n"),
+    ("median abs err %", "median"),
+    ("worst abs err %", "worst"),
+    ("median signed err %", "bias"),
+]
 
 
 def statistics_rows(datasets: list[Dataset]) -> list[dict[str, Any]]:
     """One row per comparison: dataset, model, quantity, reference and its statistics."""
-    return [{"dataset": ds.name, "model": c.model, "quantity": c.quantity,
-             "reference": c.reference, **c.stats()} for ds in datasets for c in ds.comparisons]
+    return [
+        {"dataset": ds.name, "model": c.model, "quantity": c.quantity, "reference": c.reference, **c.stats()}
+        for ds in datasets
+        for c in ds.comparisons
+    ]
 
 
 def _detail(ds: Dataset) -> list[str]:
     """The dataset's per-row tables as markdown."""
     t = ds.tables
     if ds.name == "ricsac":
-        merged = [{**p, "dv_neades": a["dv"], "dv_eff_neades": a["dv_eff"], "alpha_neades": a["alpha"],
-                   "gamma_neades": a["gamma"], "dv_nogamma": g["dv"]}
-                  for p, a, g in zip(t["crash3 published"], t["crash3 neades"], t["crash3 neades, gamma = 1"])]
-        pim = [{"test": r["test"], **{f"{k}": r.get(k) for k in
-                ("dv1", "dv1 Brach & Smith 2002", "dv2", "dv2 Brach & Smith 2002",
-                 "limpert dv1", "limpert dv2", "particle dv1", "particle dv2", "energy_loss",
-                 "brach_energy_loss", "measured_energy_loss", "mu_c", "brach_mu", "sensitivity_pct",
-                 "status")}} for r in t["pim"]]
-        return (["", "CRASH3 delta-V per vehicle [m/s] (CG delta-V; 'eff' = effective-mass delta-V):", ""]
-                + _table(merged, [("veh", "vehicle"), ("face", "face"), ("alpha pub", "alpha"),
-                                  ("capped", "capped"), ("gamma pub", "gamma"), ("dV pub", "dv"),
-                                  ("alpha Neades", "alpha_neades"), ("gamma Neades", "gamma_neades"),
-                                  ("dV Neades", "dv_neades"),
-                                  ("dV eff Neades", "dv_eff_neades"), ("dV Neades gamma=1", "dv_nogamma"),
-                                  ("meas untransf.", "untransformed"), ("meas B&S 2002", "Brach & Smith 2002"),
-                                  ("meas McHenry", "McHenry 1997"), ("Neades raw CRASH", "neades_raw_crash")])
-                + ["", "Energy loss per test [ft lb]:", ""]
-                + _table(t["energy"], [("test", "test"), ("CRASH3 pub", "published"),
-                                       ("CRASH3 pub, Woolley corr.", "published, woolley"),
-                                       ("CRASH3 Neades", "neades"), ("Woolley 1985 CRASH3", "woolley_1985"),
-                                       ("Brach PIM", "brach_pim"), ("measured", "measured"),
-                                       ("initial KE", "initial"), ("exceeds initial KE", "impossible")])
-                + ["", "Rigid PIM (Brach's e, mu = mu_c, e_m = 1) with the approximated impact centre, "
-                   "and the Limpert/IMPAC common-velocity and particle models on the same scenes "
-                   "(delta-V m/s, energy ft lb; sens. = largest rigid delta-V change % for a 0.2 m "
-                   "shift of either centre):", ""]
-                + _table(pim, [("test", "test"), ("dV1", "dv1"), ("meas 1", "dv1 Brach & Smith 2002"),
-                               ("dV2", "dv2"), ("meas 2", "dv2 Brach & Smith 2002"),
-                               ("Limpert dV1", "limpert dv1"), ("Limpert dV2", "limpert dv2"),
-                               ("particle dV1", "particle dv1"), ("particle dV2", "particle dv2"),
-                               ("TL", "energy_loss"), ("Brach TL", "brach_energy_loss"),
-                               ("measured TL", "measured_energy_loss"), ("mu_c", "mu_c"),
-                               ("Brach mu", "brach_mu"), ("sens. %", "sensitivity_pct")])
-                + ["", "Momentum balance of Vossou's measured separation velocities "
-                   "(change of total momentum, % of the initial):", ""]
-                + _table(t["momentum"], [("test", "test"), ("x %", "x_pct"), ("y %", "y_pct")]))
+        merged = [
+            {
+                **p,
+                "dv_neades": a["dv"],
+                "dv_eff_neades": a["dv_eff"],
+                "alpha_neades": a["alpha"],
+                "gamma_neades": a["gamma"],
+                "dv_nogamma": g["dv"],
+            }
+            for p, a, g in zip(t["crash3 published"], t["crash3 neades"], t["crash3 neades, gamma = 1"])
+        ]
+        pim = [
+            {
+                "test": r["test"],
+                **{
+                    f"{k}": r.get(k)
+                    for k in (
+                        "dv1",
+                        "dv1 Brach & Smith 2002",
+                        "dv2",
+                        "dv2 Brach & Smith 2002",
+                        "limpert dv1",
+                        "limpert dv2",
+                        "particle dv1",
+                        "particle dv2",
+                        "energy_loss",
+                        "brach_energy_loss",
+                        "measured_energy_loss",
+                        "mu_c",
+                        "brach_mu",
+                        "sensitivity_pct",
+                        "status",
+                    )
+                },
+            }
+            for r in t["pim"]
+        ]
+        return (
+            ["", "CRASH3 delta-V per vehicle [m/s] (CG delta-V; 'eff' = effective-mass delta-V):", ""]
+            + _table(
+                merged,
+                [
+                    ("veh", "vehicle"),
+                    ("face", "face"),
+                    ("alpha pub", "alpha"),
+                    ("capped", "capped"),
+                    ("gamma pub", "gamma"),
+                    ("dV pub", "dv"),
+                    ("alpha Neades", "alpha_neades"),
+                    ("gamma Neades", "gamma_neades"),
+                    ("dV Neades", "dv_neades"),
+                    ("dV eff Neades", "dv_eff_neades"),
+                    ("dV Neades gamma=1", "dv_nogamma"),
+                    ("meas untransf.", "untransformed"),
+                    ("meas B&S 2002", "Brach & Smith 2002"),
+                    ("meas McHenry", "McHenry 1997"),
+                    ("Neades raw CRASH", "neades_raw_crash"),
+                ],
+            )
+            + ["", "Energy loss per test [ft lb]:", ""]
+            + _table(
+                t["energy"],
+                [
+                    ("test", "test"),
+                    ("CRASH3 pub", "published"),
+                    ("CRASH3 pub, Woolley corr.", "published, woolley"),
+                    ("CRASH3 Neades", "neades"),
+                    ("Woolley 1985 CRASH3", "woolley_1985"),
+                    ("Brach PIM", "brach_pim"),
+                    ("measured", "measured"),
+                    ("initial KE", "initial"),
+                    ("exceeds initial KE", "impossible"),
+                ],
+            )
+            + [
+                "",
+                "Rigid PIM (Brach's e, mu = mu_c, e_m = 1) with the approximated impact centre, "
+                "and the Limpert/IMPAC common-velocity and particle models on the same scenes "
+                "(delta-V m/s, energy ft lb; sens. = largest rigid delta-V change % for a 0.2 m "
+                "shift of either centre):",
+                "",
+            ]
+            + _table(
+                pim,
+                [
+                    ("test", "test"),
+                    ("dV1", "dv1"),
+                    ("meas 1", "dv1 Brach & Smith 2002"),
+                    ("dV2", "dv2"),
+                    ("meas 2", "dv2 Brach & Smith 2002"),
+                    ("Limpert dV1", "limpert dv1"),
+                    ("Limpert dV2", "limpert dv2"),
+                    ("particle dV1", "particle dv1"),
+                    ("particle dV2", "particle dv2"),
+                    ("TL", "energy_loss"),
+                    ("Brach TL", "brach_energy_loss"),
+                    ("measured TL", "measured_energy_loss"),
+                    ("mu_c", "mu_c"),
+                    ("Brach mu", "brach_mu"),
+                    ("sens. %", "sensitivity_pct"),
+                ],
+            )
+            + [
+                "",
+                "Momentum balance of Vossou's measured separation velocities "
+                "(change of total momentum, % of the initial):",
+                "",
+            ]
+            + _table(t["momentum"], [("test", "test"), ("x %", "x_pct"), ("y %", "y_pct")])
+        )
     if ds.name == "iihs":
         return ["", "Per test (ft/s, deg/s):", ""] + _table(
-            t["barrier"], [("test", "test"), ("vehicle", "vehicle"), ("kind", "kind"),
-                           ("dV", "dv"), ("dV meas", "dv_measured"), ("dVx", "dvx"),
-                           ("dVx meas", "dvx_measured"), ("dVy", "dvy"), ("dVy meas", "dvy_measured"),
-                           ("yaw", "yaw"), ("yaw meas", "yaw_measured")])
+            t["barrier"],
+            [
+                ("test", "test"),
+                ("vehicle", "vehicle"),
+                ("kind", "kind"),
+                ("dV", "dv"),
+                ("dV meas", "dv_measured"),
+                ("dVx", "dvx"),
+                ("dVx meas", "dvx_measured"),
+                ("dVy", "dvy"),
+                ("dVy meas", "dvy_measured"),
+                ("yaw", "yaw"),
+                ("yaw meas", "yaw_measured"),
+            ],
+        )
     return ["", "Per vehicle (energies ft lb per test, delta-V mph, yaw deg/s):", ""] + _table(
-        t["nhtsa"], [("test", "test"), ("vehicle", "vehicle"), ("TL", "energy_loss"),
-                     ("TL pub", "energy_loss_published"), ("TLn", "normal_loss"),
-                     ("TLn pub", "normal_loss_published"), ("TLt", "tangential_loss"),
-                     ("TLt pub", "tangential_loss_published"), ("dV", "dv"), ("dV pub", "dv_published"),
-                     ("dV meas", "dv_measured"), ("yaw", "yaw"), ("yaw pub", "yaw_published")])
+        t["nhtsa"],
+        [
+            ("test", "test"),
+            ("vehicle", "vehicle"),
+            ("TL", "energy_loss"),
+            ("TL pub", "energy_loss_published"),
+            ("TLn", "normal_loss"),
+            ("TLn pub", "normal_loss_published"),
+            ("TLt", "tangential_loss"),
+            ("TLt pub", "tangential_loss_published"),
+            ("dV", "dv"),
+            ("dV pub", "dv_published"),
+            ("dV meas", "dv_measured"),
+            ("yaw", "yaw"),
+            ("yaw pub", "yaw_published"),
+        ],
+    )
 
 
 def markdown(datasets: list[Dataset], figures: Mapping[str, str] | None = None) -> str:
     """The report as markdown: per dataset the assumptions, the error
     statistics by model, the per-row tables and (optionally) the figure."""
-    lines = ["Generated by `impactsym validate --markdown` (impactsym/validation.py). "
-             "Errors: 100 (model - reference) / reference."]
+    lines = [
+        "Generated by `impactsym validate --markdown` (impactsym/validation.py). "
+        "Errors: 100 (model - reference) / reference."
+    ]
     for ds in datasets:
         lines += ["", f"### {ds.title}", ""] + [f"- {note}" for note in ds.notes]
         lines += ["", "Error statistics:", ""]
-        lines += _table([{"model": c.model, "quantity": c.quantity, "reference": c.reference,
-                          **c.stats()} for c in ds.comparisons], STATS_COLUMNS)
+        lines += _table(
+            [
+                {"model": c.model, "quantity": c.quantity, "reference": c.reference, **c.stats()}
+                for c in ds.comparisons
+            ],
+            STATS_COLUMNS,
+        )
         if figures and ds.name in figures:
             lines += ["", f"![{ds.title}]({figures[ds.name]})"]
         lines += _detail(ds)
@@ -804,6 +1237,9 @@ def text_summary(datasets: list[Dataset]) -> str:
     """The error statistics as a plain-text table for a terminal."""
     rows = statistics_rows(datasets)
     head = f"{'dataset':8} {'model':52} {'quantity':22} {'reference':30} {'n':>3} {'median%':>8} {'worst%':>8} {'bias%':>8}"
-    body = [f"{r['dataset']:8} {r['model'][:52]:52} {r['quantity'][:22]:22} {r['reference'][:30]:30} "
-            f"{r['n']:3d} {r['median']:8.1f} {r['worst']:8.1f} {r['bias']:8.1f}" for r in rows]
+    body = [
+        f"{r['dataset']:8} {r['model'][:52]:52} {r['quantity'][:22]:22} {r['reference'][:30]:30} "
+        f"{r['n']:3d} {r['median']:8.1f} {r['worst']:8.1f} {r['bias']:8.1f}"
+        for r in rows
+    ]
     return "\n".join([head, *body])

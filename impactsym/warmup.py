@@ -64,12 +64,18 @@ def start_background(generated_file: str, digest: str) -> bool:
     done = marker(generated_file, digest)
     if done.exists() or not _claim(done):
         return False
-    print("impactsym: compiling the other batch kernels in the background, once per machine "
-          f"(a few minutes; {ENV}=0 turns this off)", file=sys.stderr)
+    print(
+        "impactsym: compiling the other batch kernels in the background, once per machine "
+        f"(a few minutes; {ENV}=0 turns this off)",
+        file=sys.stderr,
+    )
     subprocess.Popen(
         [sys.executable, "-m", "impactsym", "compile", "--quiet", "--claimed"],
-        stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-        start_new_session=True, env={**os.environ, ENV: "0"},
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+        env={**os.environ, ENV: "0"},
     )
     return True
 

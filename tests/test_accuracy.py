@@ -26,6 +26,7 @@ ENERGY_CREATED, TENSILE, MU_OUT_OF_RANGE = 1, 2, 4
 @dataclass(repr=False)
 class Suite:
     """Scenes of one kind with their references (given mu and critical mode)."""
+
     name: str
     model: str
     columns: dict
@@ -53,14 +54,15 @@ def suites():
     """Random rigid, particle and fixed-barrier scenes with 50-digit references."""
     return {
         "rigid": _suite("rigid", "rigid", scenes.random_realistic(N_RIGID, 2024)),
-        "particle": _suite("particle", "particle",
-                           scenes.random_realistic(N_PARTICLE, 2025, model="particle")),
-        "barrier": _suite("barrier", "rigid",
-                          scenes.random_realistic(N_BARRIER, 2026, barrier=True)),
+        "particle": _suite(
+            "particle", "particle", scenes.random_realistic(N_PARTICLE, 2025, model="particle")
+        ),
+        "barrier": _suite("barrier", "rigid", scenes.random_realistic(N_BARRIER, 2026, barrier=True)),
     }
 
 
 # ---------------------------------------------------------------- helpers
+
 
 def _solve(columns, model, critical=False):
     """Call the package; return {key: float64 array} (critical: mu = "critical")."""
@@ -73,8 +75,10 @@ def _solve(columns, model, critical=False):
 
 def _assert_status_ok(out, label):
     bad = np.flatnonzero(np.asarray(out["status"]) != 0)
-    assert bad.size == 0, (f"{label}: {bad.size} rows not solved, first rows {bad[:10].tolist()} "
-                           f"with status {np.asarray(out['status'])[bad[:10]].tolist()}")
+    assert bad.size == 0, (
+        f"{label}: {bad.size} rows not solved, first rows {bad[:10].tolist()} "
+        f"with status {np.asarray(out['status'])[bad[:10]].tolist()}"
+    )
 
 
 def _worst_errors(suite, out, refs):
@@ -94,11 +98,13 @@ def _assert_accurate(suite, out, refs, label):
     failures = {key: value for key, value in worst.items() if not value[0] <= TOL}
     report = "; ".join(
         f"{key}: {err:.3g} at row {i} (got {got!r}, ref {mp.nstr(ref, 17)})"
-        for key, (err, i, got, ref) in sorted(failures.items(), key=lambda kv: -kv[1][0]))
+        for key, (err, i, got, ref) in sorted(failures.items(), key=lambda kv: -kv[1][0])
+    )
     assert not failures, f"{label}: outputs beyond {TOL:g} of natural scale: {report}"
 
 
 # ---------------------------------------------------------------- (a) random scenes
+
 
 @pytest.mark.slow  # exhaustive accuracy: 50-digit references of every suite (minutes)
 @pytest.mark.parametrize("name", ["rigid", "particle", "barrier"])
@@ -124,6 +130,7 @@ def test_critical_mu_equals_mu_c(suites):
 
 # ---------------------------------------------------------------- (b) seed Table 2
 
+
 @pytest.fixture(scope="module")
 def table2():
     columns, expected = scenes.table2_scenes()
@@ -147,7 +154,8 @@ def test_table2_mu_out_of_range_flag(table2):
     got = (out["flags"] & MU_OUT_OF_RANGE) != 0
     assert np.array_equal(got, expected), (
         f"flag 4 rows {np.flatnonzero(got).tolist()}, expected {np.flatnonzero(expected).tolist()} "
-        f"(mu_c = {out['mu_c'].tolist()})")
+        f"(mu_c = {out['mu_c'].tolist()})"
+    )
 
 
 def test_table2_energy_created_flag(table2):
@@ -169,11 +177,14 @@ def test_table2_physical_rows_not_flagged(table2):
     columns, _, out = table2
     physical = np.flatnonzero(columns["mu"] <= scenes.TABLE2_MU_MAX)
     flagged = [int(i) for i in physical if out["flags"][i] != 0]
-    assert not flagged, (f"physical Table 2 rows {flagged} flagged {out['flags'][flagged].tolist()}; "
-                         f"TLn {out['TLn'][flagged].tolist()} TLt {out['TLt'][flagged].tolist()}")
+    assert not flagged, (
+        f"physical Table 2 rows {flagged} flagged {out['flags'][flagged].tolist()}; "
+        f"TLn {out['TLn'][flagged].tolist()} TLt {out['TLt'][flagged].tolist()}"
+    )
 
 
 # ---------------------------------------------------------------- (c) conservation
+
 
 def _momentum_residuals(suite, out):
     """Worst relative residuals of linear / angular momentum and impulse balances.
@@ -218,8 +229,9 @@ def _momentum_residuals(suite, out):
             Py = p["Pn"] * mp.sin(g) + p["Pt"] * mp.cos(g)
             m1 = mp.mpf(row["m1"])
             P_scale = scales["Pn"] + m1 * S
-            res = mp.hypot(m1 * (p["V1x"] - mp.mpf(row["v1x"])) - Px,
-                           m1 * (p["V1y"] - mp.mpf(row["v1y"])) - Py)
+            res = mp.hypot(
+                m1 * (p["V1x"] - mp.mpf(row["v1x"])) - Px, m1 * (p["V1y"] - mp.mpf(row["v1y"])) - Py
+            )
             note("impulse on vehicle 1", float(res / P_scale), i)
     return worst
 
@@ -232,11 +244,11 @@ def test_momentum_conserved(suites, name):
     out = _solve(suite.columns, suite.model)
     worst = _momentum_residuals(suite, out)
     bad = {k: v for k, v in worst.items() if not v[0] <= TOL}
-    assert not bad, f"{name}: " + "; ".join(f"{k} residual {e:.3g} at row {i}"
-                                            for k, (e, i) in bad.items())
+    assert not bad, f"{name}: " + "; ".join(f"{k} residual {e:.3g} at row {i}" for k, (e, i) in bad.items())
 
 
 # ---------------------------------------------------------------- (d) fixed barrier
+
 
 @pytest.mark.slow  # exhaustive accuracy: 50-digit references of every suite (minutes)
 @pytest.mark.parametrize("critical", [False, True], ids=["given_mu", "critical"])
@@ -247,8 +259,9 @@ def test_fixed_barrier_stays_put(suites, critical):
     _assert_status_ok(out, "barrier")
     for key, init in (("V2x", "v2x"), ("V2y", "v2y"), ("W2", "w2")):
         moved = np.flatnonzero(out[key] != suite.columns[init])
-        assert moved.size == 0, (f"barrier {key} != {init} on rows {moved[:10].tolist()}: "
-                                 f"{out[key][moved[:3]].tolist()}")
+        assert moved.size == 0, (
+            f"barrier {key} != {init} on rows {moved[:10].tolist()}: {out[key][moved[:3]].tolist()}"
+        )
     _assert_accurate(suite, out, suite.critical if critical else suite.given, "barrier")
 
 
@@ -256,8 +269,9 @@ def test_fixed_barrier_stays_put(suites, critical):
 def test_moving_fixed_body_keeps_its_velocity(suites):
     """A fixed body given a velocity keeps it exactly (inverse masses are exactly 0)."""
     suite = suites["barrier"]
-    cols = dict(suite.columns, v2x=np.full(suite.n, 1.25), v2y=np.full(suite.n, -0.5),
-                w2=np.full(suite.n, 0.125))
+    cols = dict(
+        suite.columns, v2x=np.full(suite.n, 1.25), v2y=np.full(suite.n, -0.5), w2=np.full(suite.n, 0.125)
+    )
     out = _solve(cols, "rigid")
     ok = (out["V2x"] == 1.25) & (out["V2y"] == -0.5) & (out["W2"] == 0.125)
     ok |= out["status"] != 0  # rows that no longer approach may be refused
@@ -265,6 +279,7 @@ def test_moving_fixed_body_keeps_its_velocity(suites):
 
 
 # ---------------------------------------------------------------- flags of random scenes
+
 
 def _expected_flags(ref, scales, margin=1e-9):
     """(must_set, must_clear) bit masks implied by a reference row; ambiguous bits in neither.
@@ -303,10 +318,12 @@ def test_flags_match_reference(suites, critical):
             must_clear |= MU_OUT_OF_RANGE
             flags = int(out["flags"][i])
             if flags & must_set != must_set or flags & must_clear:
-                problems.append(f"{name} row {i}: flags {flags}, must set {must_set}, "
-                                f"must clear {must_clear} (TL parts "
-                                f"{[mp.nstr(ref[k], 6) for k in R.ENERGY_KEYS]}, "
-                                f"Pn {mp.nstr(ref['Pn'], 6)})")
+                problems.append(
+                    f"{name} row {i}: flags {flags}, must set {must_set}, "
+                    f"must clear {must_clear} (TL parts "
+                    f"{[mp.nstr(ref[k], 6) for k in R.ENERGY_KEYS]}, "
+                    f"Pn {mp.nstr(ref['Pn'], 6)})"
+                )
     assert not problems, f"{len(problems)} rows with wrong flags: " + "; ".join(problems[:5])
 
 
@@ -319,7 +336,5 @@ def test_mu_out_of_range_flag_set(suites):
     for factor in (1.5, -0.5):
         cols = dict(suite.columns, mu=factor * mu_c)
         out = _solve(cols, "rigid")
-        missing = np.flatnonzero(usable & ((out["flags"] & MU_OUT_OF_RANGE) == 0)
-                                 & (out["status"] == 0))
-        assert missing.size == 0, (f"mu = {factor} mu_c: flag 4 missing on rows "
-                                   f"{missing[:10].tolist()}")
+        missing = np.flatnonzero(usable & ((out["flags"] & MU_OUT_OF_RANGE) == 0) & (out["status"] == 0))
+        assert missing.size == 0, f"mu = {factor} mu_c: flag 4 missing on rows {missing[:10].tolist()}"

@@ -43,7 +43,7 @@ def _imports(name: str, path: Path) -> set[str]:
         elif isinstance(node, ast.ImportFrom):
             if node.level:
                 base = package.split(".")
-                base = base[:len(base) - (node.level - 1)]
+                base = base[: len(base) - (node.level - 1)]
                 origin = ".".join(base + ([node.module] if node.module else []))
             else:
                 origin = node.module
@@ -74,7 +74,7 @@ def _cycles() -> list[list[str]]:
         stack.append(node)
         for nxt in graph[node]:
             if state.get(nxt) == "open":
-                cycles.append(stack[stack.index(nxt):] + [nxt])
+                cycles.append(stack[stack.index(nxt) :] + [nxt])
             elif nxt not in state:
                 visit(nxt)
         stack.pop()
@@ -88,6 +88,7 @@ def _cycles() -> list[list[str]]:
 
 def _importers(prefixes: tuple[str, ...]) -> dict[str, list[str]]:
     """Module -> the modules it imports that are one of ``prefixes`` or inside one."""
+
     def inside(target: str) -> bool:
         return any(target == p or target.startswith(p + ".") for p in prefixes)
 
@@ -97,8 +98,13 @@ def _importers(prefixes: tuple[str, ...]) -> dict[str, list[str]]:
 
 def test_the_walk_sees_every_kind_of_import():
     """The checks below would pass vacuously if the walk missed imports."""
-    assert {"impactsym", "impactsym._kernels", "impactsym.batch", "impactsym.dask_engine",
-            "impactsym.testing.reference"} <= set(MODULES)
+    assert {
+        "impactsym",
+        "impactsym._kernels",
+        "impactsym.batch",
+        "impactsym.dask_engine",
+        "impactsym.testing.reference",
+    } <= set(MODULES)
     assert "impactsym._kernels" in IMPORTS["impactsym.batch"]  # from . import _kernels
     assert "impactsym.batch" in IMPORTS["impactsym"]  # from .batch import solve_batch
     assert "impactsym.plot" in IMPORTS["impactsym.explore"]  # function-level from . import plot

@@ -15,8 +15,7 @@ from impactsym import codes
 from impactsym.testing import scenes
 
 ROOT = Path(__file__).resolve().parent.parent
-OUTPUTS = ("V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M",
-           "mu", "mu_c", "TL", "TLn", "TLt", "TLm")
+OUTPUTS = ("V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M", "mu", "mu_c", "TL", "TLn", "TLt", "TLm")
 
 
 def _rigid(n=8, seed=3):
@@ -29,9 +28,9 @@ def test_bad_rows_get_a_status_and_the_other_rows_are_untouched():
     assert (good["status"] == 0).all()
     c["m1"][1] = np.nan
     c["I2"][2] = 0.0
-    c["m2"][3], c["I2"][3] = np.inf, 5.0          # infinite mass, finite inertia
-    c["m1"][4] = c["I1"][4] = c["m2"][4] = c["I2"][4] = np.inf   # both fixed
-    c["gamma"][5] += np.pi                         # separating instead of approaching
+    c["m2"][3], c["I2"][3] = np.inf, 5.0  # infinite mass, finite inertia
+    c["m1"][4] = c["I1"][4] = c["m2"][4] = c["I2"][4] = np.inf  # both fixed
+    c["gamma"][5] += np.pi  # separating instead of approaching
     c["v1x"][6] = np.inf
     out = impactsym.solve_batch(c)
     assert list(out["status"][1:7]) == [1, 2, 2, 4, 3, 1]
@@ -100,11 +99,12 @@ def test_column_errors_name_the_column():
 
 def test_a_single_scene_compiles_nothing():
     """A single scene runs the plain per-scene function: numba is never imported."""
-    code = ("import sys, impactsym; "
-            "impactsym.solve('examples/two_car_us.json'); "
-            "assert 'numba' not in sys.modules, 'numba imported'")
-    proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
-                          text=True, timeout=120)
+    code = (
+        "import sys, impactsym; "
+        "impactsym.solve('examples/two_car_us.json'); "
+        "assert 'numba' not in sys.modules, 'numba imported'"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
 
 
@@ -161,25 +161,29 @@ def test_a_slow_first_compile_says_so(monkeypatch, capsys):
     _kernels._call(ks, Driver([]), True, [np.zeros(3)], outs)
     _kernels._call(ks, Driver(["compiled"]), True, [np.zeros(3)], outs)
     err = capsys.readouterr().err.splitlines()
-    assert err == [err[0]] and err[0].startswith("impactsym: compiling the rigid batch kernel "
-                                                 "for this machine (once; about ")
+    assert err == [err[0]] and err[0].startswith(
+        "impactsym: compiling the rigid batch kernel for this machine (once; about "
+    )
 
 
 def test_a_read_only_install_caches_compiled_drivers_in_the_user_directory(tmp_path):
     """generated/ not writable and NUMBA_CACHE_DIR unset: the drivers are cached
     under $XDG_CACHE_HOME/impactsym/numba, and a batch runs."""
-    code = ("import os; real = os.access; "
-            "os.access = lambda p, m, **k: False if m == os.W_OK else real(p, m, **k); "
-            "import impactsym; "
-            "out = impactsym.solve_batch({'m1': [1500.0], 'm2': [1200.0], 'v1x': [20.0], "
-            "'v1y': [0.0], 'v2x': [0.0], 'v2y': [0.0], 'gamma': 0.0, 'e': 0.2, 'mu': 0.1}, "
-            "model='particle'); "
-            "assert out['status'][0] == 0, out; "
-            "import numba.core.config as cfg; print(cfg.CACHE_DIR)")
+    code = (
+        "import os; real = os.access; "
+        "os.access = lambda p, m, **k: False if m == os.W_OK else real(p, m, **k); "
+        "import impactsym; "
+        "out = impactsym.solve_batch({'m1': [1500.0], 'm2': [1200.0], 'v1x': [20.0], "
+        "'v1y': [0.0], 'v2x': [0.0], 'v2y': [0.0], 'gamma': 0.0, 'e': 0.2, 'mu': 0.1}, "
+        "model='particle'); "
+        "assert out['status'][0] == 0, out; "
+        "import numba.core.config as cfg; print(cfg.CACHE_DIR)"
+    )
     env = {k: v for k, v in __import__("os").environ.items() if k != "NUMBA_CACHE_DIR"}
     env["XDG_CACHE_HOME"] = str(tmp_path)
-    proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
-                          text=True, timeout=600, env=env)
+    proc = subprocess.run(
+        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=600, env=env
+    )
     assert proc.returncode == 0, proc.stderr
     cache = tmp_path / "impactsym" / "numba"
     assert proc.stdout.strip() == str(cache)

@@ -31,10 +31,22 @@ PLAIN = {
     "units": "US",
     "impact": {"normal_angle": 0.0, "restitution": 0.1, "impulse_ratio": 0.3, "moment_restitution": 1.0},
     "vehicles": [
-        {"name": "car 1", "mass": 100.0, "yaw_inertia": 1800.0,
-         "velocity": [50.0, 0.0], "yaw_rate": 0.0, "impact_point": [6.0, 1.0]},
-        {"name": "car 2", "mass": 150.0, "yaw_inertia": 2600.0,
-         "velocity": [0.0, 30.0], "yaw_rate": 0.0, "impact_point": [-1.5, -4.0]},
+        {
+            "name": "car 1",
+            "mass": 100.0,
+            "yaw_inertia": 1800.0,
+            "velocity": [50.0, 0.0],
+            "yaw_rate": 0.0,
+            "impact_point": [6.0, 1.0],
+        },
+        {
+            "name": "car 2",
+            "mass": 150.0,
+            "yaw_inertia": 2600.0,
+            "velocity": [0.0, 30.0],
+            "yaw_rate": 0.0,
+            "impact_point": [-1.5, -4.0],
+        },
     ],
 }
 
@@ -77,14 +89,18 @@ def test_rose_2006_nhtsa_tests_entered_as_printed_give_the_published_answers(tes
     initial = sum(0.5 * v.mass * math.hypot(*v.velocity) ** 2 for v in scene.vehicles)
     published_initial = float(car["published_initial_ke_ftlb"])
     assert initial == pytest.approx(published_initial, rel=TOLERANCE)
-    for ours, key in ((result.TL, "published_energy_loss_ftlb"), (result.TLn, "published_normal_loss_ftlb"),
-                      (result.TLt, "published_tangential_loss_ftlb")):
+    for ours, key in (
+        (result.TL, "published_energy_loss_ftlb"),
+        (result.TLn, "published_normal_loss_ftlb"),
+        (result.TLt, "published_tangential_loss_ftlb"),
+    ):
         assert ours / initial == pytest.approx(float(car[key]) / published_initial, rel=TOLERANCE), key
     for vehicle, row in zip(result.vehicles, (car, suv)):
         assert vehicle.delta_v_magnitude / MPH == pytest.approx(float(row["published_dv_mph"]), rel=TOLERANCE)
         # printed unsigned (NHTSA's frame is left-handed)
         assert abs(math.degrees(vehicle.yaw_rate)) == pytest.approx(
-            float(row["published_final_yaw_rate_degps"]), rel=TOLERANCE)
+            float(row["published_final_yaw_rate_degps"]), rel=TOLERANCE
+        )
     # the paper's normal points from the SUV toward the car: turned round, and said so
     assert any("normal_angle" in w and "opposite sense" in w for w in result.warnings)
     assert result.flags == 0
@@ -106,6 +122,7 @@ def test_the_table_shows_road_speeds_and_degrees_per_second(capsys):
 
 
 # --------------------------------------------------------------------------- alternative forms
+
 
 def _scale(values):
     return max(1.0, max(abs(v) for v in values))
@@ -160,17 +177,31 @@ def scenes(draw):
         left = draw(st.floats(-3.0, 3.0, **finite))
         rate = draw(st.floats(-2.0, 2.0, **finite))
         h, d = math.radians(heading), math.radians(direction)
-        plain["vehicles"].append({
-            "name": f"car {index + 1}", "mass": mass, "yaw_inertia": mass * k * k,
-            "velocity": [speed * math.cos(d), speed * math.sin(d)], "yaw_rate": rate,
-            "impact_point": [forward * math.cos(h) - left * math.sin(h),
-                             forward * math.sin(h) + left * math.cos(h)]})
+        plain["vehicles"].append(
+            {
+                "name": f"car {index + 1}",
+                "mass": mass,
+                "yaw_inertia": mass * k * k,
+                "velocity": [speed * math.cos(d), speed * math.sin(d)],
+                "yaw_rate": rate,
+                "impact_point": [
+                    forward * math.cos(h) - left * math.sin(h),
+                    forward * math.sin(h) + left * math.cos(h),
+                ],
+            }
+        )
         g = G_US if units == "US" else 9.80665
-        words["vehicles"].append({
-            "name": f"car {index + 1}", "weight": mass * g, "radius_of_gyration": k,
-            "heading": heading, "velocity": {"speed": speed, "direction": direction},
-            "yaw_rate": f"{rate!r} rad/s" if index else rate,
-            "impact_point": {"forward": forward, "left": left}})
+        words["vehicles"].append(
+            {
+                "name": f"car {index + 1}",
+                "weight": mass * g,
+                "radius_of_gyration": k,
+                "heading": heading,
+                "velocity": {"speed": speed, "direction": direction},
+                "yaw_rate": f"{rate!r} rad/s" if index else rate,
+                "impact_point": {"forward": forward, "left": left},
+            }
+        )
     r1, r2 = (plain["vehicles"][i]["impact_point"] for i in range(2))
     dx, dy = r1[0] - r2[0], r1[1] - r2[1]
     assume(math.hypot(dx, dy) > 1e-3)  # the geometry must tell the normal's sense
@@ -180,8 +211,11 @@ def scenes(draw):
     mu = draw(st.floats(-0.5, 0.5, **finite))
     plain["impact"] = {"normal_angle": gamma, "restitution": e, "impulse_ratio": mu}
     # the other sense of the normal, e and μ as unit-less strings with a unit
-    words["impact"] = {"normal_angle": f"{math.radians(gamma + 180.0)!r} rad",
-                       "restitution": f"{100.0 * e!r} percent", "impulse_ratio": mu}
+    words["impact"] = {
+        "normal_angle": f"{math.radians(gamma + 180.0)!r} rad",
+        "restitution": f"{100.0 * e!r} percent",
+        "impulse_ratio": mu,
+    }
     return plain, words
 
 
@@ -209,17 +243,26 @@ def test_every_alternative_form_gives_the_plain_result(pair):
 
 def test_unit_strings_convert_to_the_scene_system():
     data = copy.deepcopy(PLAIN)
-    data["vehicles"][0].update(mass="1459.390293720637 kg", velocity=["34.09090909090909 mph", "0 km/h"],
-                               yaw_rate="0 deg/s", impact_point=["72 in", "0.3048 m"],
-                               yaw_inertia="1800 slug*ft**2")
+    data["vehicles"][0].update(
+        mass="1459.390293720637 kg",
+        velocity=["34.09090909090909 mph", "0 km/h"],
+        yaw_rate="0 deg/s",
+        impact_point=["72 in", "0.3048 m"],
+        yaw_inertia="1800 slug*ft**2",
+    )
     data["impact"]["normal_angle"] = "0 deg"
     _assert_same_inputs(PLAIN, data)
 
 
 def test_pounds_mass_and_pounds_force_give_the_same_mass():
     masses = []
-    for entry in ({"mass": "3451 lb"}, {"weight": "3451 lb"}, {"weight": "3451 lbf"}, {"weight": 3451},
-                  {"mass": "3451 lbf"}):
+    for entry in (
+        {"mass": "3451 lb"},
+        {"weight": "3451 lb"},
+        {"weight": "3451 lbf"},
+        {"weight": 3451},
+        {"mass": "3451 lbf"},
+    ):
         data = copy.deepcopy(PLAIN)
         del data["vehicles"][0]["mass"]
         data["vehicles"][0].update(entry)
@@ -231,8 +274,9 @@ def test_pounds_mass_and_pounds_force_give_the_same_mass():
 def test_distance_and_angle_impact_point_is_the_vehicle_frame():
     a = copy.deepcopy(PLAIN)
     b = copy.deepcopy(PLAIN)
-    a["vehicles"][0].update(heading=30.0, impact_point={"forward": 5.0 * math.cos(0.4),
-                                                        "left": 5.0 * math.sin(0.4)})
+    a["vehicles"][0].update(
+        heading=30.0, impact_point={"forward": 5.0 * math.cos(0.4), "left": 5.0 * math.sin(0.4)}
+    )
     b["vehicles"][0].update(heading=30.0, impact_point={"distance": 5.0, "angle": math.degrees(0.4)})
     _assert_same_inputs(a, b)
 
@@ -243,11 +287,15 @@ def test_reconstruction_heading_serves_both_travel_and_vehicle_frame():
     for vehicle in words["vehicles"]:
         h = math.radians(vehicle["heading"])
         x, y = vehicle["impact_point"]
-        vehicle["impact_point"] = {"forward": x * math.cos(h) + y * math.sin(h),
-                                   "left": -x * math.sin(h) + y * math.cos(h)}
+        vehicle["impact_point"] = {
+            "forward": x * math.cos(h) + y * math.sin(h),
+            "left": -x * math.sin(h) + y * math.cos(h),
+        }
         vx, vy = vehicle["final_velocity"]
-        vehicle["final_velocity"] = {"speed": f"{3.6 * math.hypot(vx, vy)!r} km/h",
-                                     "direction": math.degrees(math.atan2(vy, vx))}
+        vehicle["final_velocity"] = {
+            "speed": f"{3.6 * math.hypot(vx, vy)!r} km/h",
+            "direction": math.degrees(math.atan2(vy, vx)),
+        }
     a, b = impactsym.reconstruct(data), impactsym.reconstruct(words)
     for va, vb in zip(a.vehicles, b.vehicles):
         assert vb.speed == pytest.approx(va.speed, rel=1e-12, abs=1e-12)
@@ -256,6 +304,7 @@ def test_reconstruction_heading_serves_both_travel_and_vehicle_frame():
 
 # --------------------------------------------------------------------------- one-line errors, exit 2
 
+
 def _edited(edit):
     data = copy.deepcopy(PLAIN)
     edit(data)
@@ -263,30 +312,54 @@ def _edited(edit):
 
 
 BAD = {
-    "wrong_dimension": (lambda d: d["vehicles"][0].update(mass="35 mph"),
-                        "vehicles[0].mass: needs a mass (kg, lb, slug), got '35 mph' (a speed)"),
-    "wrong_angle": (lambda d: d["impact"].update(normal_angle="3 m"),
-                    "impact.normal_angle: needs an angle (deg, rad), got '3 m' (a length)"),
-    "unknown_key": (lambda d: d["impact"].update(moment_restitutoin=0.5),
-                    'impact.moment_restitutoin: unknown key; did you mean "moment_restitution"?'),
-    "unknown_vehicle_key": (lambda d: d["vehicles"][1].update(wieght=3000),
-                            'vehicles[1].wieght: unknown key; did you mean "weight"?'),
-    "unknown_polar_key": (lambda d: d["vehicles"][0].update(velocity={"speed": 1, "directoin": 0}),
-                          'vehicles[0].velocity.directoin: unknown key; did you mean "direction"?'),
-    "frame_without_heading": (lambda d: d["vehicles"][0].update(impact_point={"forward": 1, "left": 0}),
-                              "vehicles[0].impact_point: in the vehicle frame"),
-    "weight_and_mass": (lambda d: d["vehicles"][0].update(weight=3000),
-                        "vehicles[0].weight: give mass or weight, not both"),
-    "inertia_and_radius": (lambda d: d["vehicles"][0].update(radius_of_gyration=4),
-                           "vehicles[0].radius_of_gyration: give yaw_inertia or radius_of_gyration"),
-    "negative_weight": (lambda d: (d["vehicles"][0].pop("mass"), d["vehicles"][0].update(weight="-5 lbf")),
-                        "vehicles[0].weight: must be a positive finite number, got '-5 lbf'"),
-    "bad_distribution": (lambda d: d["impact"].update(restitution={"uniforn": [0.1, 0.2]}),
-                         'impact.restitution.uniforn: unknown key; did you mean "uniform"?'),
-    "bad_sd": (lambda d: d["impact"].update(restitution={"normal": [0.1, -0.02]}),
-               "impact.restitution.normal: the standard deviation must be positive"),
-    "bad_correlation": (lambda d: d.update(correlations=[["impact.restitution", "vehicles[0].mass", 0.5]]),
-                        "correlations[0]: 'impact.restitution' is not an uncertain leaf"),
+    "wrong_dimension": (
+        lambda d: d["vehicles"][0].update(mass="35 mph"),
+        "vehicles[0].mass: needs a mass (kg, lb, slug), got '35 mph' (a speed)",
+    ),
+    "wrong_angle": (
+        lambda d: d["impact"].update(normal_angle="3 m"),
+        "impact.normal_angle: needs an angle (deg, rad), got '3 m' (a length)",
+    ),
+    "unknown_key": (
+        lambda d: d["impact"].update(moment_restitutoin=0.5),
+        'impact.moment_restitutoin: unknown key; did you mean "moment_restitution"?',
+    ),
+    "unknown_vehicle_key": (
+        lambda d: d["vehicles"][1].update(wieght=3000),
+        'vehicles[1].wieght: unknown key; did you mean "weight"?',
+    ),
+    "unknown_polar_key": (
+        lambda d: d["vehicles"][0].update(velocity={"speed": 1, "directoin": 0}),
+        'vehicles[0].velocity.directoin: unknown key; did you mean "direction"?',
+    ),
+    "frame_without_heading": (
+        lambda d: d["vehicles"][0].update(impact_point={"forward": 1, "left": 0}),
+        "vehicles[0].impact_point: in the vehicle frame",
+    ),
+    "weight_and_mass": (
+        lambda d: d["vehicles"][0].update(weight=3000),
+        "vehicles[0].weight: give mass or weight, not both",
+    ),
+    "inertia_and_radius": (
+        lambda d: d["vehicles"][0].update(radius_of_gyration=4),
+        "vehicles[0].radius_of_gyration: give yaw_inertia or radius_of_gyration",
+    ),
+    "negative_weight": (
+        lambda d: (d["vehicles"][0].pop("mass"), d["vehicles"][0].update(weight="-5 lbf")),
+        "vehicles[0].weight: must be a positive finite number, got '-5 lbf'",
+    ),
+    "bad_distribution": (
+        lambda d: d["impact"].update(restitution={"uniforn": [0.1, 0.2]}),
+        'impact.restitution.uniforn: unknown key; did you mean "uniform"?',
+    ),
+    "bad_sd": (
+        lambda d: d["impact"].update(restitution={"normal": [0.1, -0.02]}),
+        "impact.restitution.normal: the standard deviation must be positive",
+    ),
+    "bad_correlation": (
+        lambda d: d.update(correlations=[["impact.restitution", "vehicles[0].mass", 0.5]]),
+        "correlations[0]: 'impact.restitution' is not an uncertain leaf",
+    ),
 }
 
 
@@ -304,10 +377,12 @@ def test_bad_case_file_is_one_line_exit_2(capsys, tmp_path, name):
 
 def test_unknown_key_in_toml_is_an_error(capsys, tmp_path):
     path = tmp_path / "typo.toml"
-    path.write_text('units = "US"\n[impact]\nnormal_angle = 0\nrestitution = 0.1\nimpulse_ratio = 0.3\n'
-                    'moment_restitutoin = 0.5\n[[vehicles]]\nmass = 100\nyaw_inertia = 1800\n'
-                    'velocity = [50, 0]\nimpact_point = [6, 1]\n[[vehicles]]\nmass = 150\n'
-                    'yaw_inertia = 2600\nvelocity = [0, 30]\nimpact_point = [-1.5, -4]\n')
+    path.write_text(
+        'units = "US"\n[impact]\nnormal_angle = 0\nrestitution = 0.1\nimpulse_ratio = 0.3\n'
+        "moment_restitutoin = 0.5\n[[vehicles]]\nmass = 100\nyaw_inertia = 1800\n"
+        "velocity = [50, 0]\nimpact_point = [6, 1]\n[[vehicles]]\nmass = 150\n"
+        "yaw_inertia = 2600\nvelocity = [0, 30]\nimpact_point = [-1.5, -4]\n"
+    )
     code, _, err = run(capsys, "solve", path)
     assert code == 2 and 'did you mean "moment_restitution"?' in err
 
@@ -322,19 +397,25 @@ def test_unknown_key_is_an_error_in_the_api_for_every_kind(kind):
 
 # --------------------------------------------------------------------------- keys not used
 
+
 def test_keys_a_command_does_not_use_are_reported():
     inverse = json.loads((EXAMPLES / "invert_two_car_si.json").read_text())
     inverse["vehicles"][0]["velocity"] = [1.0, 2.0]
-    assert any(w.startswith("vehicles[0].velocity is given but not used") for w in impactsym.invert(inverse).warnings)
+    assert any(
+        w.startswith("vehicles[0].velocity is given but not used") for w in impactsym.invert(inverse).warnings
+    )
 
     rec = json.loads((EXAMPLES / "reconstruct_two_car_si.json").read_text())
     rec["impact"]["restitution"] = 0.3
-    assert any(w.startswith("impact.restitution is given but not used")
-               for w in impactsym.reconstruct(rec).warnings)
+    assert any(
+        w.startswith("impact.restitution is given but not used") for w in impactsym.reconstruct(rec).warnings
+    )
 
     forward = copy.deepcopy(PLAIN)
     forward["vehicles"][0]["crush"] = {"A": 300, "B": 90, "width": 60, "depths": [5, 5], "pdof": 0}
-    assert any(w.startswith("vehicles[0].crush is given but not used") for w in impactsym.solve(forward).warnings)
+    assert any(
+        w.startswith("vehicles[0].crush is given but not used") for w in impactsym.solve(forward).warnings
+    )
 
     options = {**copy.deepcopy(PLAIN), "crash3": {"restitution": 0.1}}
     assert any(w.startswith("crash3 is given but not used") for w in impactsym.solve(options).warnings)
@@ -342,11 +423,14 @@ def test_keys_a_command_does_not_use_are_reported():
     barrier = json.loads((EXAMPLES / "barrier_si.json").read_text())
     fixed = next(i for i, v in enumerate(barrier["vehicles"]) if v.get("fixed"))
     barrier["vehicles"][fixed]["mass"] = 1e6
-    assert any(w.startswith(f"vehicles[{fixed}].mass is given but not used")
-               for w in impactsym.solve(barrier).warnings)
+    assert any(
+        w.startswith(f"vehicles[{fixed}].mass is given but not used")
+        for w in impactsym.solve(barrier).warnings
+    )
 
 
 # --------------------------------------------------------------------------- normal sense
+
 
 def test_either_sense_of_the_normal_gives_the_same_result():
     other = copy.deepcopy(PLAIN)
@@ -367,15 +451,29 @@ def test_particles_keep_the_given_sense_and_the_approach_check_stays():
 # --------------------------------------------------------------------------- uncertain leaves
 
 UNCERTAIN = {
-    "model": "rigid", "units": "US",
-    "impact": {"normal_angle": {"uniform": ["-5 deg", "5 deg"]},
-               "restitution": {"triangular": [0.0, 0.1, 0.3]}, "impulse_ratio": 0.3},
+    "model": "rigid",
+    "units": "US",
+    "impact": {
+        "normal_angle": {"uniform": ["-5 deg", "5 deg"]},
+        "restitution": {"triangular": [0.0, 0.1, 0.3]},
+        "impulse_ratio": 0.3,
+    },
     "vehicles": [
-        {"name": "car 1", "weight": {"normal": ["3220 lbf", "50 lbf"]}, "radius_of_gyration": 4.24,
-         "heading": 0.0, "velocity": {"speed": {"normal": ["34.1 mph", "1 mph"]}, "direction": 0.0},
-         "impact_point": {"forward": 6.0, "left": 1.0}},
-        {"name": "car 2", "mass": 150.0, "yaw_inertia": 2600.0, "velocity": [0.0, 30.0],
-         "impact_point": [-1.5, -4.0]},
+        {
+            "name": "car 1",
+            "weight": {"normal": ["3220 lbf", "50 lbf"]},
+            "radius_of_gyration": 4.24,
+            "heading": 0.0,
+            "velocity": {"speed": {"normal": ["34.1 mph", "1 mph"]}, "direction": 0.0},
+            "impact_point": {"forward": 6.0, "left": 1.0},
+        },
+        {
+            "name": "car 2",
+            "mass": 150.0,
+            "yaw_inertia": 2600.0,
+            "velocity": [0.0, 30.0],
+            "impact_point": [-1.5, -4.0],
+        },
     ],
     "correlations": [["vehicles[0].weight", "vehicles[0].velocity.speed", 0.3]],
 }
@@ -387,8 +485,12 @@ def test_uncertain_leaves_solve_at_their_nominal_values():
     assert scene.vehicles[0].mass == pytest.approx(3220 / G_US, rel=1e-14)
     assert scene.vehicles[0].velocity[0] == pytest.approx(34.1 * MPH, rel=1e-14)
     uncertain = {path: (kind, params) for path, kind, params in scene.uncertain}
-    assert set(uncertain) == {"impact.normal_angle", "impact.restitution", "vehicles[0].weight",
-                              "vehicles[0].velocity.speed"}
+    assert set(uncertain) == {
+        "impact.normal_angle",
+        "impact.restitution",
+        "vehicles[0].weight",
+        "vehicles[0].velocity.speed",
+    }
     assert uncertain["impact.normal_angle"] == ("uniform", (-5.0, 5.0))
     assert uncertain["vehicles[0].velocity.speed"][0] == "normal"
     assert uncertain["vehicles[0].velocity.speed"][1] == pytest.approx((34.1 * MPH, MPH), rel=1e-14)
@@ -396,13 +498,22 @@ def test_uncertain_leaves_solve_at_their_nominal_values():
     impactsym.solve(UNCERTAIN)
 
 
-@pytest.mark.parametrize(("correlations", "text"), [
-    ([["vehicles[0].weight", "vehicles[0].weight", 0.3]], "itself"),
-    ([["vehicles[0].weight", "impact.restitution", 1.5]], "rho must be a number in [-1, 1]"),
-    ([["vehicles[0].weight", "impact.restitution", 0.9], ["impact.restitution", "impact.normal_angle", 0.9],
-      ["vehicles[0].weight", "impact.normal_angle", -0.9]], "not positive semi-definite"),
-    ([["vehicles[0].wieght", "impact.restitution", 0.3]], 'did you mean "vehicles[0].weight"?'),
-])
+@pytest.mark.parametrize(
+    ("correlations", "text"),
+    [
+        ([["vehicles[0].weight", "vehicles[0].weight", 0.3]], "itself"),
+        ([["vehicles[0].weight", "impact.restitution", 1.5]], "rho must be a number in [-1, 1]"),
+        (
+            [
+                ["vehicles[0].weight", "impact.restitution", 0.9],
+                ["impact.restitution", "impact.normal_angle", 0.9],
+                ["vehicles[0].weight", "impact.normal_angle", -0.9],
+            ],
+            "not positive semi-definite",
+        ),
+        ([["vehicles[0].wieght", "impact.restitution", 0.3]], 'did you mean "vehicles[0].weight"?'),
+    ],
+)
 def test_bad_correlations_are_one_line_errors(correlations, text):
     data = {**UNCERTAIN, "correlations": correlations}
     with pytest.raises(SceneError) as info:
@@ -414,15 +525,23 @@ def test_scene_columns_rows_equal_scenes_loaded_one_by_one():
     scene = load_scene(UNCERTAIN)
     rng = np.random.default_rng(7)
     n = 6
-    draws = {"vehicles[0].weight": rng.normal(3220, 50, n),
-             "vehicles[0].velocity.speed": rng.normal(50, 2, n),
-             "impact.normal_angle": np.array([-5.0, 0.0, 5.0, 180.0, 2.0, -3.0]),
-             "impact.restitution": np.array([0.1, 0.2, -0.1, 0.05, 0.3, 0.0])}
+    draws = {
+        "vehicles[0].weight": rng.normal(3220, 50, n),
+        "vehicles[0].velocity.speed": rng.normal(50, 2, n),
+        "impact.normal_angle": np.array([-5.0, 0.0, 5.0, 180.0, 2.0, -3.0]),
+        "impact.restitution": np.array([0.1, 0.2, -0.1, 0.05, 0.3, 0.0]),
+    }
     draws["vehicles[0].weight"][4] = -10.0
     out = scene_columns(scene, draws)
     assert out.rows == n
-    assert list(out.reason) == ["", "", "impact.restitution is outside [0, 1]", "",
-                                "vehicles[0].weight is not positive", ""]
+    assert list(out.reason) == [
+        "",
+        "",
+        "impact.restitution is outside [0, 1]",
+        "",
+        "vehicles[0].weight is not positive",
+        "",
+    ]
     assert list(out.flipped) == [False, False, False, True, False, False]
     for row in (0, 1, 3, 5):
         data = copy.deepcopy(UNCERTAIN)
@@ -450,11 +569,14 @@ def test_scene_columns_feed_the_batch_kernels():
         assert batch["TL"][row] == pytest.approx(single.TL, rel=1e-12)
 
 
-@pytest.mark.parametrize(("source", "kind", "names"), [
-    ("invert_two_car_si.json", "inverse", {"V1x", "W2", "e", "mu", "e_m", "gamma", "r1x"}),
-    ("reconstruct_two_car_si.json", "reconstruct", {"theta1", "theta2", "V1x", "w1", "gamma"}),
-    ("crash3_two_car_us.json", "crash3", {"m1", "gamma", "crush"}),
-])
+@pytest.mark.parametrize(
+    ("source", "kind", "names"),
+    [
+        ("invert_two_car_si.json", "inverse", {"V1x", "W2", "e", "mu", "e_m", "gamma", "r1x"}),
+        ("reconstruct_two_car_si.json", "reconstruct", {"theta1", "theta2", "V1x", "w1", "gamma"}),
+        ("crash3_two_car_us.json", "crash3", {"m1", "gamma", "crush"}),
+    ],
+)
 def test_scene_columns_of_other_kinds(source, kind, names):
     scene = load_scene(EXAMPLES / source, kind=kind)
     out = scene_columns(scene)
@@ -471,13 +593,25 @@ def test_scene_columns_refuses_unknown_paths():
 
 # --------------------------------------------------------------------------- start-up
 
+
 def test_plain_scenes_do_not_import_pint():
-    code = ("import sys, impactsym; impactsym.load_scene('examples/two_car_us.json'); "
-            "assert 'pint' not in sys.modules; "
-            "impactsym.load_scene('examples/rose2006_nhtsa4364_us.json'); assert 'pint' in sys.modules")
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])))
-    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True,
-                          timeout=300, check=False)
+    code = (
+        "import sys, impactsym; impactsym.load_scene('examples/two_car_us.json'); "
+        "assert 'pint' not in sys.modules; "
+        "impactsym.load_scene('examples/rose2006_nhtsa4364_us.json'); assert 'pint' in sys.modules"
+    )
+    env = dict(
+        os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code],
+        cwd=ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
     assert done.returncode == 0, done.stderr
 
 

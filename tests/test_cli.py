@@ -17,8 +17,11 @@ ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 # Forward scenes; the other kinds are named by their command (invert_*, reconstruct_*, ...).
 OTHER_KINDS = ("invert_", "reconstruct_", "crash3_")
-EXAMPLE_FILES = [path for path in sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml"))
-                 if not path.name.startswith(OTHER_KINDS)]
+EXAMPLE_FILES = [
+    path
+    for path in sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml"))
+    if not path.name.startswith(OTHER_KINDS)
+]
 ENERGY_CREATED = 1
 
 CONVENTIONS_SCENE = json.loads((EXAMPLES / "two_car_us.json").read_text())
@@ -48,16 +51,25 @@ def assert_documented_shape(result):
         assert all(isinstance(x, float) and math.isfinite(x) for x in numbers)
     assert set(result["impulse"]) == {"normal", "tangential", "moment"}
     assert set(result["energy_loss"]) == {"total", "normal", "tangential", "moment"}
-    scalars = [*result["impulse"].values(), *result["energy_loss"].values(),
-               result["impulse_ratio"], result["critical_impulse_ratio"]]
+    scalars = [
+        *result["impulse"].values(),
+        *result["energy_loss"].values(),
+        result["impulse_ratio"],
+        result["critical_impulse_ratio"],
+    ]
     assert all(isinstance(x, float) and math.isfinite(x) for x in scalars)
     assert isinstance(result["warnings"], list) and all(isinstance(w, str) for w in result["warnings"])
 
 
 def test_examples_exist():
     names = {path.name for path in EXAMPLE_FILES}
-    assert {"table2_e0_mu1.json", "table2_e1_mu1p5.toml", "two_car_us.json",
-            "intersection_si.toml", "barrier_si.json"} <= names
+    assert {
+        "table2_e0_mu1.json",
+        "table2_e1_mu1p5.toml",
+        "two_car_us.json",
+        "intersection_si.toml",
+        "barrier_si.json",
+    } <= names
 
 
 @pytest.mark.parametrize("path", EXAMPLE_FILES, ids=lambda path: path.name)
@@ -124,10 +136,16 @@ def test_barrier_keeps_still_and_warns_about_nothing(capsys):
 
 
 def test_python_dash_m_runs_the_cli():
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])))
+    env = dict(
+        os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))
+    )
     done = subprocess.run(
         [sys.executable, "-m", "impactsym", "solve", str(EXAMPLES / "two_car_us.json"), "--json"],
-        capture_output=True, text=True, cwd=ROOT, env=env, timeout=300,
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        env=env,
+        timeout=300,
     )
     assert done.returncode == 0, done.stderr
     assert_documented_shape(json.loads(done.stdout))
@@ -142,17 +160,28 @@ def scene_variant(edit):
 
 BAD_SCENES = {
     "nan_mass.json": (
-        json.dumps(CONVENTIONS_SCENE).replace('"mass": 100.0', '"mass": NaN'), "vehicles[0].mass"),
+        json.dumps(CONVENTIONS_SCENE).replace('"mass": 100.0', '"mass": NaN'),
+        "vehicles[0].mass",
+    ),
     "missing_field.json": (
-        scene_variant(lambda d: d["impact"].pop("restitution")), "impact.restitution: missing"),
+        scene_variant(lambda d: d["impact"].pop("restitution")),
+        "impact.restitution: missing",
+    ),
     "unknown_units.json": (
-        scene_variant(lambda d: d.update(units="metric")), "units: unknown units 'metric'"),
+        scene_variant(lambda d: d.update(units="metric")),
+        "units: unknown units 'metric'",
+    ),
     "not_approaching.json": (
-        scene_variant(lambda d: d["vehicles"][0].update(velocity=[-50.0, 0.0])), "not approaching"),
+        scene_variant(lambda d: d["vehicles"][0].update(velocity=[-50.0, 0.0])),
+        "not approaching",
+    ),
     "malformed.json": ('{"model": "rigid", "units": "US",', "invalid JSON"),
     "malformed.toml": ('units = "US"\n[[vehicles]\n', "invalid TOML"),
-    "wrong_count.toml": ('units = "SI"\n[impact]\nnormal_angle = 0\nrestitution = 0\nimpulse_ratio = 0\n'
-                         '[[vehicles]]\nmass = 1\nvelocity = [1, 0]\n', "vehicles: must be a list of exactly 2"),
+    "wrong_count.toml": (
+        'units = "SI"\n[impact]\nnormal_angle = 0\nrestitution = 0\nimpulse_ratio = 0\n'
+        "[[vehicles]]\nmass = 1\nvelocity = [1, 0]\n",
+        "vehicles: must be a list of exactly 2",
+    ),
 }
 
 
@@ -179,9 +208,17 @@ def test_bad_scene_exits_2_with_one_line(capsys, tmp_path, name, as_json):
 def test_bad_scene_in_a_subprocess_has_no_traceback(tmp_path):
     path = tmp_path / "nan_mass.json"
     path.write_text(BAD_SCENES["nan_mass.json"][0])
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])))
-    done = subprocess.run([sys.executable, "-m", "impactsym", "solve", str(path), "--json"],
-                          capture_output=True, text=True, cwd=ROOT, env=env, timeout=300)
+    env = dict(
+        os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))
+    )
+    done = subprocess.run(
+        [sys.executable, "-m", "impactsym", "solve", str(path), "--json"],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        env=env,
+        timeout=300,
+    )
     assert_one_line_error(done.returncode, done.stdout, done.stderr, "vehicles[0].mass")
 
 

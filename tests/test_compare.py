@@ -17,8 +17,11 @@ DATA = json.loads(MODELS_SCENE.read_text())
 
 def kinetic_energy(vehicles):
     """Initial kinetic energy, translational plus yaw (independent of the kernels)."""
-    return sum(v["mass"] * (v["velocity"][0] ** 2 + v["velocity"][1] ** 2) / 2
-               + v["yaw_inertia"] * v.get("yaw_rate", 0.0) ** 2 / 2 for v in vehicles)
+    return sum(
+        v["mass"] * (v["velocity"][0] ** 2 + v["velocity"][1] ** 2) / 2
+        + v["yaw_inertia"] * v.get("yaw_rate", 0.0) ** 2 / 2
+        for v in vehicles
+    )
 
 
 @pytest.fixture(scope="module")
@@ -28,7 +31,14 @@ def comparison():
 
 def test_every_model_runs_on_the_full_scene(comparison):
     assert [row.model for row in comparison.rows] == [
-        "brach", "macmillan", "limpert", "impac", "impac_sideswipe", "particle", "crash3"]
+        "brach",
+        "macmillan",
+        "limpert",
+        "impac",
+        "impac_sideswipe",
+        "particle",
+        "crash3",
+    ]
     assert comparison.skipped == {}
     assert comparison.initial_kinetic_energy == pytest.approx(kinetic_energy(DATA["vehicles"]), rel=1e-14)
 
@@ -36,24 +46,32 @@ def test_every_model_runs_on_the_full_scene(comparison):
 def test_rows_equal_each_model_solved_alone(comparison):
     rows = {row.model: row for row in comparison.rows}
     for model in ("brach", "limpert", "impac_sideswipe", "particle"):
-        keep = {"normal_angle", *impactsym.scene.PRESETS[model]["required"],
-                *impactsym.scene.PRESETS[model]["optional"]}
-        alone = impactsym.solve({**DATA, "model": model,
-                                 "impact": {k: v for k, v in DATA["impact"].items() if k in keep}})
+        keep = {
+            "normal_angle",
+            *impactsym.scene.PRESETS[model]["required"],
+            *impactsym.scene.PRESETS[model]["optional"],
+        }
+        alone = impactsym.solve(
+            {**DATA, "model": model, "impact": {k: v for k, v in DATA["impact"].items() if k in keep}}
+        )
         row = rows[model]
         assert row.energy["total"] == alone.TL
-        assert row.energy_percent["total"] == pytest.approx(100 * alone.TL / comparison.initial_kinetic_energy)
+        assert row.energy_percent["total"] == pytest.approx(
+            100 * alone.TL / comparison.initial_kinetic_energy
+        )
         for got, want in zip(row.vehicles, alone.vehicles):
             assert got.velocity == want.velocity and got.delta_v_magnitude == want.delta_v_magnitude
             assert got.speed == pytest.approx(math.hypot(*want.velocity))
-            assert math.radians(got.direction) == pytest.approx(math.atan2(want.velocity[1], want.velocity[0]))
+            assert math.radians(got.direction) == pytest.approx(
+                math.atan2(want.velocity[1], want.velocity[0])
+            )
     assert rows["particle"].vehicles[0].yaw_rate is None and rows["particle"].energy["moment"] is None
 
 
 def test_identical_models_give_identical_rows(comparison):
     rows = {row.model: row for row in comparison.rows}
-    assert rows["limpert"].vehicles == rows["impac"].vehicles       # seed Table 7
-    assert rows["macmillan"].vehicles == rows["brach"].vehicles     # the scene has e_m = 1
+    assert rows["limpert"].vehicles == rows["impac"].vehicles  # seed Table 7
+    assert rows["macmillan"].vehicles == rows["brach"].vehicles  # the scene has e_m = 1
 
 
 def test_crash3_row(comparison):
@@ -62,7 +80,10 @@ def test_crash3_row(comparison):
     assert row.energy["total"] == alone.energy_total and row.energy["normal"] is None
     for got, want, given in zip(row.vehicles, alone.vehicles, DATA["vehicles"]):
         assert got.delta_v_magnitude == want.delta_v_magnitude and got.yaw_rate is None
-        assert got.velocity == (given["velocity"][0] + want.delta_v[0], given["velocity"][1] + want.delta_v[1])
+        assert got.velocity == (
+            given["velocity"][0] + want.delta_v[0],
+            given["velocity"][1] + want.delta_v[1],
+        )
     assert any("implies" in w for w in row.warnings)
 
 
@@ -96,7 +117,9 @@ def test_cli_compare_formats_are_exclusive(capsys):
     assert "not allowed with" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("scene", [MODELS_SCENE, ROOT / "examples" / "crash3_two_car_us.json"], ids=lambda p: p.name)
+@pytest.mark.parametrize(
+    "scene", [MODELS_SCENE, ROOT / "examples" / "crash3_two_car_us.json"], ids=lambda p: p.name
+)
 def test_plot_has_a_title_headroom_and_legends_off_the_bars(scene):
     from matplotlib.patches import Rectangle
 
@@ -104,13 +127,22 @@ def test_plot_has_a_title_headroom_and_legends_off_the_bars(scene):
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
     assert fig.get_suptitle().startswith(f"{scene.name}: model comparison")
-    bars = {ax: [p for p in ax.patches if isinstance(p, Rectangle) and p.get_height() != 0] for ax in fig.axes}
+    bars = {
+        ax: [p for p in ax.patches if isinstance(p, Rectangle) and p.get_height() != 0] for ax in fig.axes
+    }
     assert bars[fig.axes[0]]  # |delta-V| (a crush-only scene has no energy percentages)
     for ax, drawn in bars.items():
         low, high = ax.get_ylim()
         # at least 5 % of the axis height free above the highest bar
-        assert max((bar.get_y() + bar.get_height() for bar in drawn), default=low) <= high - 0.05 * (high - low)
+        assert max((bar.get_y() + bar.get_height() for bar in drawn), default=low) <= high - 0.05 * (
+            high - low
+        )
     legends = [ax.get_legend().get_window_extent(renderer) for ax in fig.axes if ax.get_legend()]
-    covered = [(legend, bar) for legend in legends for drawn in bars.values() for bar in drawn
-               if legend.overlaps(bar.get_window_extent(renderer))]
+    covered = [
+        (legend, bar)
+        for legend in legends
+        for drawn in bars.values()
+        for bar in drawn
+        if legend.overlaps(bar.get_window_extent(renderer))
+    ]
     assert not covered

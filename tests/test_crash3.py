@@ -35,13 +35,15 @@ def numeric_energy(A, B, width, depths, n=200_001):
 def barrier_scene(depths, pdof=0.0, A=35000.0, B=1.0e6, width=1.5, mass=1500.0, **vehicle):
     data = copy.deepcopy(BARRIER)
     data["vehicles"][0].update(mass=mass, **vehicle)
-    data["vehicles"][0]["crush"] = {"A": A, "B": B, "width": width, "depths": list(depths),
-                                    "pdof": pdof}
+    data["vehicles"][0]["crush"] = {"A": A, "B": B, "width": width, "depths": list(depths), "pdof": pdof}
     return data
 
 
-@pytest.mark.parametrize("depths", [[0.2, 0.5], [0.1, 0.4, 0.25, 0.0], [0.3, 0.32, 0.4, 0.1, 0.0, 0.05]],
-                         ids=["2 points", "4 points", "6 points"])
+@pytest.mark.parametrize(
+    "depths",
+    [[0.2, 0.5], [0.1, 0.4, 0.25, 0.0], [0.3, 0.32, 0.4, 0.1, 0.0, 0.05]],
+    ids=["2 points", "4 points", "6 points"],
+)
 def test_crush_energy_equals_numeric_integration(depths):
     result = impactsym.crash3(barrier_scene(depths))
     expected = numeric_energy(35000.0, 1.0e6, 1.5, depths)
@@ -74,14 +76,17 @@ def test_pdof_beyond_90_degrees_is_an_error():
         impactsym.crash3(barrier_scene([0.3, 0.3], pdof=-90.5))
 
 
-@pytest.mark.parametrize(("change", "text"), [
-    ({"depths": [0.1, 0.2, 0.3]}, "depths: must be a list of 2, 4 or 6 crush depths"),
-    ({"depths": [0.1, -0.2]}, "crush.depths[1]: must be >= 0 (a crush depth), got -0.2"),
-    ({"B": 0.0}, "crush.B: must be > 0 (the slope of force per unit width against crush), got 0"),
-    ({"A": -1.0}, "crush.A: must be >= 0"),
-    ({"width": 0.0}, "crush.width: must be > 0 (the damage width)"),
-    ({"A": "stiff"}, "crush.A: must be a finite number"),
-])
+@pytest.mark.parametrize(
+    ("change", "text"),
+    [
+        ({"depths": [0.1, 0.2, 0.3]}, "depths: must be a list of 2, 4 or 6 crush depths"),
+        ({"depths": [0.1, -0.2]}, "crush.depths[1]: must be >= 0 (a crush depth), got -0.2"),
+        ({"B": 0.0}, "crush.B: must be > 0 (the slope of force per unit width against crush), got 0"),
+        ({"A": -1.0}, "crush.A: must be >= 0"),
+        ({"width": 0.0}, "crush.width: must be > 0 (the damage width)"),
+        ({"A": "stiff"}, "crush.A: must be a finite number"),
+    ],
+)
 def test_bad_crush_tables_name_their_field(change, text):
     data = barrier_scene([0.3, 0.3])
     data["vehicles"][0]["crush"].update(change)
@@ -138,9 +143,9 @@ def test_effective_mass_from_yaw_inertia_and_impact_point():
     result = impactsym.crash3(TWO_CAR)
     assert TWO_CAR["impact"]["normal_angle"] == 0.0
     for vehicle, out in zip(TWO_CAR["vehicles"], result.vehicles):
-        assert vehicle["crush"]["pdof"] == 0.0      # so the PDOF line is along x
+        assert vehicle["crush"]["pdof"] == 0.0  # so the PDOF line is along x
         k2 = vehicle["yaw_inertia"] / vehicle["mass"]
-        h = vehicle["impact_point"][1]              # |r × (±1, 0)| = |ry|
+        h = vehicle["impact_point"][1]  # |r × (±1, 0)| = |ry|
         assert abs(out.moment_arm) == pytest.approx(abs(h), rel=1e-14)
         assert out.mass_factor == pytest.approx(k2 / (k2 + h * h), rel=1e-14)
 
@@ -172,21 +177,30 @@ def test_with_the_implied_pdof_and_energy_crash3_is_the_common_velocity_solution
     centre. Give CRASH3 the PDOF of the common-velocity (Limpert) solution and a
     crush whose corrected energy is that solution's energy loss: it returns the same
     |delta-V|. The moment arm and radius of gyration come from the scene."""
-    car = {"name": "car", "mass": 1500.0, "yaw_inertia": 2500.0, "velocity": [14.0, 3.0],
-           "impact_point": [2.3, -0.4]}
-    scene = {"model": "limpert", "units": "SI", "impact": {"normal_angle": 10.0},
-             "vehicles": [car, {"name": "barrier", "fixed": True}]}
+    car = {
+        "name": "car",
+        "mass": 1500.0,
+        "yaw_inertia": 2500.0,
+        "velocity": [14.0, 3.0],
+        "impact_point": [2.3, -0.4],
+    }
+    scene = {
+        "model": "limpert",
+        "units": "SI",
+        "impact": {"normal_angle": 10.0},
+        "vehicles": [car, {"name": "barrier", "fixed": True}],
+    }
     limpert = impactsym.solve(scene)
     alpha = math.degrees(math.atan(limpert.mu))
     A, B, width = 35000.0, 1.0e6, 1.5
-    target = limpert.TL * math.cos(math.radians(alpha)) ** 2 / width   # energy per unit width
+    target = limpert.TL * math.cos(math.radians(alpha)) ** 2 / width  # energy per unit width
     depth = (-A + math.sqrt(A * A - 2 * B * (A * A / (2 * B) - target))) / B  # A C + B C²/2 + G = target
-    crushed = {**car, "crush": {"A": A, "B": B, "width": width, "depths": [depth, depth],
-                                "pdof": alpha}}
+    crushed = {**car, "crush": {"A": A, "B": B, "width": width, "depths": [depth, depth], "pdof": alpha}}
     result = impactsym.crash3({**scene, "vehicles": [crushed, scene["vehicles"][1]]})
     assert result.energy_total == pytest.approx(limpert.TL, rel=1e-12)
     assert result.vehicles[0].delta_v_magnitude == pytest.approx(
-        limpert.vehicles[0].delta_v_magnitude, rel=1e-10)
+        limpert.vehicles[0].delta_v_magnitude, rel=1e-10
+    )
     assert result.vehicles[0].pdof_implied == pytest.approx(alpha, abs=1e-9)
     assert not any("implies" in w for w in result.warnings)
 
@@ -195,10 +209,11 @@ def test_entered_pdof_against_the_implied_one_is_reported():
     data = json.loads((ROOT / "examples" / "models_two_car_us.json").read_text())
     result = impactsym.crash3(data)
     implied = result.vehicles[0].pdof_implied
-    assert implied == pytest.approx(math.degrees(math.atan(impactsym.solve(
-        {**data, "model": "limpert"}).mu_c)), abs=1e-9)
+    assert implied == pytest.approx(
+        math.degrees(math.atan(impactsym.solve({**data, "model": "limpert"}).mu_c)), abs=1e-9
+    )
     assert sum("CRASH3 takes |delta-V| from mu = mu_max" in w for w in result.warnings) == 2
-    assert impactsym.crash3(TWO_CAR).vehicles[0].pdof_implied is None   # no velocities
+    assert impactsym.crash3(TWO_CAR).vehicles[0].pdof_implied is None  # no velocities
 
 
 def test_cli_crash3_json_and_table(capsys):
@@ -231,11 +246,19 @@ def test_a_wrong_effective_mass_fails_its_proof(monkeypatch):
 
     knl = derive_crash3.KERNELS[3]
     wrong = {derive_crash3.h1: 2 * derive_crash3.h1}
-    blocks = tuple(Block(tuple((s, x.xreplace(wrong) if s == derive_crash3.ke1 else x)
-                               for s, x in block.assigns), block.guard) for block in knl.blocks)
+    blocks = tuple(
+        Block(
+            tuple((s, x.xreplace(wrong) if s == derive_crash3.ke1 else x) for s, x in block.assigns),
+            block.guard,
+        )
+        for block in knl.blocks
+    )
     bad = dataclasses.replace(knl, blocks=blocks)
-    monkeypatch.setattr(derive_crash3, "KERNELS",
-                        derive_crash3.KERNELS[:3] + (bad,) + derive_crash3.KERNELS[4:])
+    monkeypatch.setattr(
+        derive_crash3, "KERNELS", derive_crash3.KERNELS[:3] + (bad,) + derive_crash3.KERNELS[4:]
+    )
     results = dict(derive_crash3._delta_v_claims())
-    assert not results["crash3_delta_v: given the common-velocity rigid solution's PDOF and "
-                       "energy loss it returns that solution's |P| exactly"]
+    assert not results[
+        "crash3_delta_v: given the common-velocity rigid solution's PDOF and "
+        "energy loss it returns that solution's |P| exactly"
+    ]

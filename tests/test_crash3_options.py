@@ -51,7 +51,7 @@ def test_category_lookup_equals_the_published_table(row):
 
 
 def test_category_misprints_and_gaps():
-    assert stiffness(1, "front").A == 302.0            # printed "J02"
+    assert stiffness(1, "front").A == 302.0  # printed "J02"
     assert stiffness(6, "side") == stiffness(5, "side").__class__(6, "side", 177.0, 47.0)
     for category, face in ((7, "side"), (8, "side"), (9, "rear"), (9, "side")):
         with pytest.raises(ValueError, match=f"category {category} has no {face} stiffness"):
@@ -75,11 +75,14 @@ def test_category_in_a_scene_equals_explicit_a_b():
 def test_mixed_category_and_explicit_scene_and_class_k2():
     result = impactsym.crash3(CATEGORIES)
     data = json.loads(CATEGORIES.read_text())
-    k = math.sqrt(3324.0) / 12.0          # class 3 k² [in²] in feet
+    k = math.sqrt(3324.0) / 12.0  # class 3 k² [in²] in feet
     h = data["vehicles"][1]["crush"]["moment_arm"]
     assert result.vehicles[1].mass_factor == pytest.approx(k * k / (k * k + h * h), rel=1e-14)
-    assert result.options.to_json_dict() == {"restitution": 0.1, "energy": "absorbed",
-                                             "correction": "woolley"}
+    assert result.options.to_json_dict() == {
+        "restitution": 0.1,
+        "energy": "absorbed",
+        "correction": "woolley",
+    }
 
 
 @pytest.mark.parametrize("alpha", [0.0, 15.0, 30.0, 44.9])
@@ -149,8 +152,11 @@ def test_scene_options_and_arguments_override_them():
     from_scene = impactsym.crash3(data)
     assert from_scene.options.to_json_dict() == data["crash3"]
     overridden = impactsym.crash3(data, restitution=0.0, energy="dissipated", correction="crash3")
-    assert overridden.options.to_json_dict() == {"restitution": 0.0, "energy": "dissipated",
-                                                 "correction": "crash3"}
+    assert overridden.options.to_json_dict() == {
+        "restitution": 0.0,
+        "energy": "dissipated",
+        "correction": "crash3",
+    }
     assert overridden.energy_total == impactsym.crash3(BARRIER).energy_total
 
 
@@ -169,22 +175,32 @@ def test_no_impact_block_needed():
 def test_compare_runs_a_crush_only_scene():
     comparison = impactsym.compare(CATEGORIES)
     assert [row.model for row in comparison.rows] == ["crash3"]
-    assert set(comparison.skipped) == {"brach", "macmillan", "limpert", "impac",
-                                       "impac_sideswipe", "particle"}
+    assert set(comparison.skipped) == {
+        "brach",
+        "macmillan",
+        "limpert",
+        "impac",
+        "impac_sideswipe",
+        "particle",
+    }
     assert all("needs a forward scene" in reason for reason in comparison.skipped.values())
     crash = impactsym.crash3(CATEGORIES)
-    assert [v.delta_v_magnitude for v in comparison.rows[0].vehicles] == \
-        [v.delta_v_magnitude for v in crash.vehicles]
+    assert [v.delta_v_magnitude for v in comparison.rows[0].vehicles] == [
+        v.delta_v_magnitude for v in crash.vehicles
+    ]
     assert comparison.initial_kinetic_energy is None
     assert "crash3" in comparison.table() and json.dumps(comparison.to_json_dict())
 
 
-@pytest.mark.parametrize(("change", "field"), [
-    ({"B": 0.0}, "vehicles[0].crush.B: must be > 0"),
-    ({"category": 3, "face": "front"}, "vehicles[0].crush.category: give either A and B or category"),
-    ({"pdof": 90.0}, "vehicles[0].crush.pdof: |pdof| = 90 must be < 90"),
-    ({"widht": 1.5}, 'vehicles[0].crush.widht: unknown key; did you mean "width"?'),
-])
+@pytest.mark.parametrize(
+    ("change", "field"),
+    [
+        ({"B": 0.0}, "vehicles[0].crush.B: must be > 0"),
+        ({"category": 3, "face": "front"}, "vehicles[0].crush.category: give either A and B or category"),
+        ({"pdof": 90.0}, "vehicles[0].crush.pdof: |pdof| = 90 must be < 90"),
+        ({"widht": 1.5}, 'vehicles[0].crush.widht: unknown key; did you mean "width"?'),
+    ],
+)
 def test_bad_crush_is_one_line_exit_2(change, field, tmp_path, capsys):
     data = barrier(**change)
     path = tmp_path / "bad.json"
@@ -209,15 +225,34 @@ def test_bad_category_face_and_option_names(tmp_path, capsys):
     assert main(["crash3", str(path)]) == 2
     assert "crash3.energy: must be one of dissipated, absorbed, got 'lost'" in capsys.readouterr().err
     assert main(["crash3", str(path), "--energy", "absorbed", "--correction", "cosine"]) == 2
-    assert capsys.readouterr().err.strip().endswith("correction: must be one of crash3, woolley, got 'cosine'")
+    assert (
+        capsys.readouterr().err.strip().endswith("correction: must be one of crash3, woolley, got 'cosine'")
+    )
 
 
 def test_cli_flags_in_a_subprocess():
     """The installed entry point with the three flags: JSON reflects them."""
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    out = subprocess.run([sys.executable, "-m", "impactsym", "crash3", str(CATEGORIES), "--json",
-                          "--restitution", "0.0", "--energy", "dissipated", "--correction", "crash3"],
-                         capture_output=True, text=True, env=env, check=True)
+    out = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "impactsym",
+            "crash3",
+            str(CATEGORIES),
+            "--json",
+            "--restitution",
+            "0.0",
+            "--energy",
+            "dissipated",
+            "--correction",
+            "crash3",
+        ],
+        capture_output=True,
+        text=True,
+        env=env,
+        check=True,
+    )
     result = json.loads(out.stdout)
     assert result["options"] == {"restitution": 0.0, "energy": "dissipated", "correction": "crash3"}
     assert "delta_v_effective_mass" in result["vehicles"][0]

@@ -32,7 +32,7 @@ def assert_same(got, want) -> None:
 
 
 def test_without_a_client_dask_runs_on_its_default_scheduler():
-    assert dask_engine._client() is None   # this test must run before the cluster fixture exists
+    assert dask_engine._client() is None  # this test must run before the cluster fixture exists
     local = impactsym.sweep(US, **GRID, chunk_size=9)
     assert_same(impactsym.sweep(US, **GRID, chunk_size=9, engine="dask"), local)
 
@@ -43,8 +43,12 @@ def client():
     and the plans they carry are then pickled and run in other interpreters,
     as on a real cluster (and each worker's numba kernels are its own); the
     kernels load from numba's cache, so start-up stays about two seconds."""
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster, distributed.Client(cluster) as c:
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as c,
+    ):
         yield c
 
 
@@ -82,9 +86,14 @@ def _columns(n: int) -> dict:
     """A mixed batch: random speeds and coefficients, some rows critical, some bad."""
     rng = np.random.default_rng(4)
     _family, _critical, base = impactsym.load_scene(US).to_inputs()
-    columns = {**base, "v1x": rng.uniform(20, 60, n), "e": rng.uniform(0, 0.5, n),
-               "mu": np.array([("critical" if i % 5 == 0 else float(rng.uniform(0, 0.3)))
-                               for i in range(n)], dtype=object)}
+    columns = {
+        **base,
+        "v1x": rng.uniform(20, 60, n),
+        "e": rng.uniform(0, 0.5, n),
+        "mu": np.array(
+            [("critical" if i % 5 == 0 else float(rng.uniform(0, 0.3))) for i in range(n)], dtype=object
+        ),
+    }
     columns["v1x"][7] = np.nan
     return columns
 
@@ -106,8 +115,10 @@ def test_solve_batch_on_the_cluster_equals_local(client):
 @pytest.mark.slow  # a two-process LocalCluster whose workers each load the kernels
 def test_solve_batch_of_a_dataframe_keeps_its_index(client):
     columns = _columns(300)
-    frame = pd.DataFrame({k: np.broadcast_to(v, (300,)) for k, v in columns.items()},
-                         index=pd.Index(np.arange(300) * 3 + 1000, name="case"))
+    frame = pd.DataFrame(
+        {k: np.broadcast_to(v, (300,)) for k, v in columns.items()},
+        index=pd.Index(np.arange(300) * 3 + 1000, name="case"),
+    )
     local = impactsym.solve_batch(frame, outputs="impulses")
     assert_same(batch.solve_batch_dask(frame, outputs="impulses", chunk_size=64), local)
     assert_same(impactsym.solve_batch(frame, outputs="impulses", engine="dask"), local)

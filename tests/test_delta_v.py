@@ -25,9 +25,20 @@ def test_forward_energy_loss_gives_back_the_forward_delta_v():
     fwd = impactsym.solve_batch(c)
     ok = fwd["status"] == 0
     dv = impactsym.delta_v_from_energy(
-        fwd["TL"], c["m1"], c["m2"], e=c["e"], mu=c["mu"], r=_approach_ratio(c),
-        gamma=c["gamma"], I1=c["I1"], I2=c["I2"], r1x=c["r1x"], r1y=c["r1y"],
-        r2x=c["r2x"], r2y=c["r2y"])
+        fwd["TL"],
+        c["m1"],
+        c["m2"],
+        e=c["e"],
+        mu=c["mu"],
+        r=_approach_ratio(c),
+        gamma=c["gamma"],
+        I1=c["I1"],
+        I2=c["I2"],
+        r1x=c["r1x"],
+        r1y=c["r1y"],
+        r2x=c["r2x"],
+        r2y=c["r2y"],
+    )
     want1 = np.hypot(fwd["V1x"] - c["v1x"], fwd["V1y"] - c["v1y"])
     want2 = np.hypot(fwd["V2x"] - c["v2x"], fwd["V2y"] - c["v2y"])
     solved = ok & (dv["status"] == 0)

@@ -18,13 +18,17 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 def _run_derive(*args, cwd=ROOT):
-    return subprocess.run([sys.executable, "-m", "derive", *args], cwd=cwd,
-                          capture_output=True, text=True, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "derive", *args], cwd=cwd, capture_output=True, text=True, timeout=300
+    )
 
 
 @pytest.mark.slow  # SymPy proves every claim: minutes
-@pytest.mark.parametrize("module", [particle, planar, delta_v, inverse, reconstruct, presets, crash3,
-                                    report], ids=lambda m: m.__name__)
+@pytest.mark.parametrize(
+    "module",
+    [particle, planar, delta_v, inverse, reconstruct, presets, crash3, report],
+    ids=lambda m: m.__name__,
+)
 def test_every_proof_passes(module):
     failed = [claim for claim, ok in module.proofs() if not ok]
     assert not failed, f"failed proofs: {failed}"
@@ -38,8 +42,7 @@ def test_a_wrong_formula_fails_its_proof(monkeypatch):
     def wrong(sticking):
         blocks = good(sticking)
         first = blocks[0]
-        bad = tuple((s, x * (1 + frame.e / 1000) if s == frame.dgn else x)
-                    for s, x in first.assigns)
+        bad = tuple((s, x * (1 + frame.e / 1000) if s == frame.dgn else x) for s, x in first.assigns)
         return (type(first)(bad, first.guard),) + blocks[1:]
 
     monkeypatch.setattr(planar, "_impulse_blocks", wrong)
@@ -116,11 +119,19 @@ def test_emitted_code_keeps_the_careful_forms():
 
 
 def test_runtime_never_imports_sympy_or_derive():
-    code = ("import sys, impactsym; impactsym.solve('examples/two_car_us.json'); "
-            "bad = [m for m in sys.modules if m.split('.')[0] in ('sympy', 'derive')]; "
-            "print(bad); sys.exit(1 if bad else 0)")
-    proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True,
-                          text=True, timeout=120, env={**os.environ, "PYTHONPATH": ""})
+    code = (
+        "import sys, impactsym; impactsym.solve('examples/two_car_us.json'); "
+        "bad = [m for m in sys.modules if m.split('.')[0] in ('sympy', 'derive')]; "
+        "print(bad); sys.exit(1 if bad else 0)"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "PYTHONPATH": ""},
+    )
     assert proc.returncode == 0, proc.stdout + proc.stderr
 
 
@@ -130,11 +141,13 @@ def test_a_squared_denominator_keeps_its_parentheses(expr):
     e = sp.sympify(expr)
     values = {"x": 2.0, "y": 3.0, "z": 5.0}
     assert eval(emit.code(e), {"math": __import__("math"), **values}) == pytest.approx(
-        float(e.subs(values)), rel=1e-15)
+        float(e.subs(values)), rel=1e-15
+    )
 
 
-@pytest.mark.parametrize("module", ["planar", "particle", "inverse", "reconstruct", "delta_v",
-                                    "presets", "report"])
+@pytest.mark.parametrize(
+    "module", ["planar", "particle", "inverse", "reconstruct", "delta_v", "presets", "report"]
+)
 def test_per_scene_functions_never_raise(module):
     """Guards precede the divisions and square roots they protect: on any mix of
     zeros, signs, infinities, NaN and extreme magnitudes a per-scene function
@@ -144,8 +157,7 @@ def test_per_scene_functions_never_raise(module):
     import random
 
     mod = importlib.import_module(f"generated.{module}")
-    values = (0.0, -0.0, -1.0, 1.0, 2.5, -3.0, math.inf, -math.inf, math.nan, 1e-300, 1e300,
-              5e-324)
+    values = (0.0, -0.0, -1.0, 1.0, 2.5, -3.0, math.inf, -math.inf, math.nan, 1e-300, 1e300, 5e-324)
     rng = random.Random(1)
     for name, row in mod.MANIFEST.items():
         function = getattr(mod, name)

@@ -91,7 +91,9 @@ def test_an_unsolvable_setting_is_reported_and_the_scene_still_drawn():
 def test_preset_models_show_only_their_free_coefficients():
     limpert = Explorer(EXAMPLES / "limpert_two_car_us.json")
     assert limpert.used == () and limpert.critical.value and limpert.critical.disabled
-    assert all(limpert.sliders[key].disabled for key in ("restitution", "impulse_ratio", "moment_restitution"))
+    assert all(
+        limpert.sliders[key].disabled for key in ("restitution", "impulse_ratio", "moment_restitution")
+    )
     assert "fixed by the model" in limpert.widget.children[0].children[0].value
     sideswipe = Explorer(EXAMPLES / "impac_sideswipe_si.json")
     assert sideswipe.used == ("slip",)
@@ -124,9 +126,11 @@ def test_update_time_is_measured(capsys):
     wall = (time.perf_counter() - start) / len(values)
     assert len(ex.timings) == len(values)
     with capsys.disabled():
-        print(f"\nexplorer update: median {1e3 * statistics.median(ex.timings):.1f} ms, "
-              f"mean {1e3 * wall:.1f} ms, max {1e3 * max(ex.timings):.1f} ms over {len(values)} updates "
-              f"(last solve {1e3 * ex.last_timing[0]:.2f} ms)")
+        print(
+            f"\nexplorer update: median {1e3 * statistics.median(ex.timings):.1f} ms, "
+            f"mean {1e3 * wall:.1f} ms, max {1e3 * max(ex.timings):.1f} ms over {len(values)} updates "
+            f"(last solve {1e3 * ex.last_timing[0]:.2f} ms)"
+        )
 
 
 def test_without_ipywidgets_explore_says_how_to_install(monkeypatch):

@@ -48,8 +48,8 @@ def one_line_error(capsys, *argv) -> str:
 
 # --------------------------------------------------------------------------- 1. scene files
 
-@pytest.mark.parametrize("name, text", [("deep.json", "[" * 100_000),
-                                        ("deep.toml", "a = " + "[" * 100_000)])
+
+@pytest.mark.parametrize("name, text", [("deep.json", "[" * 100_000), ("deep.toml", "a = " + "[" * 100_000)])
 def test_deeply_nested_file_is_one_line(tmp_path, capsys, name, text):
     path = tmp_path / name
     path.write_text(text)
@@ -96,28 +96,52 @@ def test_version(capsys):
 
 # --------------------------------------------------------------------------- 2. the batch API
 
-RIGID = dict(m1=1000.0, m2=1500.0, I1=1500.0, I2=2500.0, v1x=15.0, v1y=0.0, w1=0.0, v2x=0.0,
-             v2y=0.0, w2=0.0, r1x=1.0, r1y=0.2, r2x=-1.2, r2y=0.0, gamma=0.0, e=0.2, mu=0.0,
-             e_m=1.0)
+RIGID = dict(
+    m1=1000.0,
+    m2=1500.0,
+    I1=1500.0,
+    I2=2500.0,
+    v1x=15.0,
+    v1y=0.0,
+    w1=0.0,
+    v2x=0.0,
+    v2y=0.0,
+    w2=0.0,
+    r1x=1.0,
+    r1y=0.2,
+    r2x=-1.2,
+    r2y=0.0,
+    gamma=0.0,
+    e=0.2,
+    mu=0.0,
+    e_m=1.0,
+)
 PARTICLE = {k: RIGID[k] for k in ("m1", "m2", "v1x", "v1y", "v2x", "v2y", "gamma", "e", "mu")}
 
 
 def test_empty_columns_give_an_empty_result_with_every_column():
     empty = {k: np.array([]) for k in RIGID}
     every = set(impactsym.solve_batch(RIGID))
-    for out in (impactsym.solve_batch(empty), impactsym.solve_batch(empty, model=[]),
-                impactsym.solve_batch(pd.DataFrame(empty))):
+    for out in (
+        impactsym.solve_batch(empty),
+        impactsym.solve_batch(empty, model=[]),
+        impactsym.solve_batch(pd.DataFrame(empty)),
+    ):
         assert set(out) == every and all(len(out[k]) == 0 for k in every)
-    finals = {("V" + k[1:]) if k[0] == "v" else ("W" + k[1:]) if k[0] == "w" else k: v
-              for k, v in empty.items()}
+    finals = {
+        ("V" + k[1:]) if k[0] == "v" else ("W" + k[1:]) if k[0] == "w" else k: v for k, v in empty.items()
+    }
     assert all(len(v) == 0 for v in impactsym.invert_batch(finals).values())
 
 
 def test_unknown_column_is_refused_with_the_nearest_name():
-    with pytest.raises(ValueError, match=r'^restitusion: unknown column; did you mean "e" '
-                                         r'\(restitution\)\?$'):
+    with pytest.raises(
+        ValueError,
+        match=r'^restitusion: unknown column; did you mean "e" '
+        r"\(restitution\)\?$",
+    ):
         impactsym.solve_batch({**RIGID, "restitusion": 0.2})
-    with pytest.raises(ValueError, match="^e_mm: unknown column; did you mean \"e_m\"\\?$"):
+    with pytest.raises(ValueError, match='^e_mm: unknown column; did you mean "e_m"\\?$'):
         impactsym.solve_batch({**RIGID, "e_mm": 1.0})
 
 
@@ -131,14 +155,17 @@ def test_a_column_the_model_does_not_read_is_refused():
         impactsym.reconstruct_batch({"foo": 1.0})
 
 
-@pytest.mark.parametrize("value, said", [
-    (np.array([True, False]), "true/false"),
-    (np.array(["0.2", "0.3"]), "text"),
-    ("0.2", "text"),
-    (None, "None"),
-    (np.array([0.2, None], dtype=object), "None"),
-    (np.zeros(2, dtype=[("a", float), ("b", float)]), "structured array"),
-])
+@pytest.mark.parametrize(
+    "value, said",
+    [
+        (np.array([True, False]), "true/false"),
+        (np.array(["0.2", "0.3"]), "text"),
+        ("0.2", "text"),
+        (None, "None"),
+        (np.array([0.2, None], dtype=object), "None"),
+        (np.zeros(2, dtype=[("a", float), ("b", float)]), "structured array"),
+    ],
+)
 def test_a_column_that_is_not_numbers_is_one_line_naming_it(value, said):
     with pytest.raises(ValueError, match=f"^e: .*{said}") as info:
         impactsym.solve_batch({**RIGID, "e": value})
@@ -150,11 +177,14 @@ def test_numbers_in_an_object_column_are_accepted():
     assert list(out["status"]) == [0, 0]
 
 
-@pytest.mark.parametrize("columns, said", [
-    ([RIGID, RIGID], "a list"),
-    (np.zeros(2, dtype=[(k, float) for k in RIGID]), "a structured array"),
-    (None, "got NoneType"),
-])
+@pytest.mark.parametrize(
+    "columns, said",
+    [
+        ([RIGID, RIGID], "a list"),
+        (np.zeros(2, dtype=[(k, float) for k in RIGID]), "a structured array"),
+        (None, "got NoneType"),
+    ],
+)
 def test_a_batch_that_is_not_a_mapping_is_one_line(columns, said):
     for call in (impactsym.solve_batch, impactsym.invert_batch, impactsym.reconstruct_batch):
         with pytest.raises(ValueError, match=f"^columns: .*{said}"):
@@ -179,16 +209,20 @@ def test_every_batch_docstring_says_angles_are_radians():
 
 # --------------------------------------------------------------------------- 3. overflow, angles
 
+
 def _with_vehicle0(**changes):
     vehicles = [dict(SCENE["vehicles"][0], **changes), SCENE["vehicles"][1]]
     return {**SCENE, "vehicles": vehicles}
 
 
-@pytest.mark.parametrize("changes, field, size", [
-    ({"velocity": [1e308, 0.0]}, "vehicles[0].velocity[0]", "large"),
-    ({"velocity": [1e200, 0.0]}, "vehicles[0].velocity[0]", "large"),
-    ({"weight": 1e-320}, "vehicles[0].weight", "small"),
-])
+@pytest.mark.parametrize(
+    "changes, field, size",
+    [
+        ({"velocity": [1e308, 0.0]}, "vehicles[0].velocity[0]", "large"),
+        ({"velocity": [1e200, 0.0]}, "vehicles[0].velocity[0]", "large"),
+        ({"weight": 1e-320}, "vehicles[0].weight", "small"),
+    ],
+)
 def test_overflow_names_the_input_that_drives_it(changes, field, size):
     scene = _with_vehicle0(**changes)
     if "weight" in changes:
@@ -211,13 +245,14 @@ def test_an_absurd_normal_angle_is_refused_as_an_angle():
         impactsym.solve(scene)
     assert info.value.field == "impact.normal_angle"
     # A large but sensible angle (read modulo 360) still solves, as its reduced twin does.
-    turned = {**SCENE, "impact": {**SCENE["impact"],
-                                  "normal_angle": SCENE["impact"]["normal_angle"] + 720}}
+    turned = {**SCENE, "impact": {**SCENE["impact"], "normal_angle": SCENE["impact"]["normal_angle"] + 720}}
     assert impactsym.solve(turned).vehicles[0].velocity == pytest.approx(
-        impactsym.solve(SCENE).vehicles[0].velocity, rel=1e-12)
+        impactsym.solve(SCENE).vehicles[0].velocity, rel=1e-12
+    )
 
 
 # --------------------------------------------------------------------------- 4. -0.0 and residue
+
 
 def test_json_never_prints_negative_zero():
     assert json.dumps([json_number(-0.0), json_number(0.0), json_number(-1.5)]) == "[0.0, 0.0, -1.5]"
@@ -226,15 +261,15 @@ def test_json_never_prints_negative_zero():
 
 def _command(path: Path) -> str:
     """The command an example is written for (by its name's prefix)."""
-    for prefix, command in (("invert_", "invert"), ("reconstruct_", "reconstruct"),
-                            ("crash3_", "crash3")):
+    for prefix, command in (("invert_", "invert"), ("reconstruct_", "reconstruct"), ("crash3_", "crash3")):
         if path.name.startswith(prefix):
             return command
     return "solve"
 
 
-@pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml")),
-                         ids=lambda p: p.name)
+@pytest.mark.parametrize(
+    "path", sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml")), ids=lambda p: p.name
+)
 def test_no_example_prints_negative_zero_in_json(path, capsys):
     # crash3_barrier_si.json printed a -0.0 delta-V component before.
     code, out, err = run(capsys, _command(path), path, "--json")
@@ -251,17 +286,17 @@ def test_tables_show_rounding_residue_as_zero_but_json_keeps_it(capsys):
     assert velocity.split()[-1] == "0"
     code, out, _ = run(capsys, "reconstruct", path, "--json")
     residue = json.loads(out)["vehicles"][1]["velocity"][0]
-    assert 0 < abs(residue) < 1e-12   # the API and JSON keep the computed value
+    assert 0 < abs(residue) < 1e-12  # the API and JSON keep the computed value
 
 
 def test_residue_is_judged_against_the_scale_of_its_unit():
     rows = [("v [m/s]", 50.0, 7.3e-16), ("tiny [J]", 1e-15, 2e-15), ("mu", 0.3, -1e-17)]
-    assert without_residue(rows) == [("v [m/s]", 50.0, 0.0), ("tiny [J]", 1e-15, 2e-15),
-                                     ("mu", 0.3, 0.0)]
+    assert without_residue(rows) == [("v [m/s]", 50.0, 0.0), ("tiny [J]", 1e-15, 2e-15), ("mu", 0.3, 0.0)]
     assert without_residue([("v [m/s]", 50.0, 1e-9)]) == [("v [m/s]", 50.0, 1e-9)]
 
 
 # --------------------------------------------------------------------------- 5. the command line
+
 
 def _cli(*argv) -> list[str]:
     """The command line of ``impactsym`` in a subprocess of this checkout."""
@@ -277,12 +312,17 @@ def test_a_plot_error_names_the_option_once(capsys):
     assert err.count("--plot") == 1 and "argument" not in err
     # Other argparse errors keep their "argument" prefix.
     assert "argument --chunk-size: invalid int value" in one_line_error(
-        capsys, "sweep", EXAMPLES / "two_car_us.json", "--chunk-size", "x")
+        capsys, "sweep", EXAMPLES / "two_car_us.json", "--chunk-size", "x"
+    )
 
 
 def test_a_reader_that_goes_away_gets_no_error():
-    process = subprocess.Popen(_cli("solve", EXAMPLES / "two_car_us.json", "--json"),
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=_env())
+    process = subprocess.Popen(
+        _cli("solve", EXAMPLES / "two_car_us.json", "--json"),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=_env(),
+    )
     process.stdout.close()  # the reader is gone before the first write: EPIPE for sure
     err = process.stderr.read()
     assert process.wait(timeout=60) == 1
@@ -292,12 +332,14 @@ def test_a_reader_that_goes_away_gets_no_error():
 def test_ctrl_c_is_one_line_and_exit_130(capsys, monkeypatch):
     def interrupted(args):
         raise KeyboardInterrupt
+
     monkeypatch.setitem(COMMANDS, "solve", dataclasses.replace(COMMANDS["solve"], run=interrupted))
     code, out, err = run(capsys, "solve", EXAMPLES / "two_car_us.json")
     assert (code, out, err) == (130, "", "impactsym: interrupted\n")
 
 
 # --------------------------------------------------------------------------- 6. reconstruct e_m
+
 
 def test_reconstruct_warns_when_the_implied_moment_restitution_is_outside_its_range():
     scene = json.loads((EXAMPLES / "reconstruct_two_car_si.json").read_text())
@@ -309,8 +351,7 @@ def test_reconstruct_warns_when_the_implied_moment_restitution_is_outside_its_ra
     for rate in (-8.0, -4.0, -1.791, 0.0, 4.0, 8.0):
         scene["vehicles"][1]["final_yaw_rate"] = rate
         result = impactsym.reconstruct(scene)
-        warned = [w for w in result.warnings
-                  if f"e_m = {result.e_m:.6g} is outside [-1, 1]" in w]
+        warned = [w for w in result.warnings if f"e_m = {result.e_m:.6g} is outside [-1, 1]" in w]
         assert (abs(result.e_m) > 1.0) == bool(warned), rate
         outside += abs(result.e_m) > 1.0
     assert 0 < outside < 6
@@ -346,8 +387,7 @@ def test_a_sweep_where_no_row_solves_says_so_without_nan_statistics(capsys):
 
 
 def test_sweep_json(capsys):
-    code, out, err = run(capsys, "sweep", US_SCENE, "--vary", "m1=-1:100:3", "--json",
-                         "--no-progress")
+    code, out, err = run(capsys, "sweep", US_SCENE, "--vary", "m1=-1:100:3", "--json", "--no-progress")
     assert (code, err) == (0, "")
     data = json.loads(out)
     assert data["units"] == "US" and "seed" not in data
@@ -360,14 +400,25 @@ def test_sweep_json(capsys):
 
 
 def test_sample_of_velocities_prints_a_table(capsys):
-    code, out, err = run(capsys, "sample", US_SCENE, "--dist", "e=uniform:0:0.3", "-n", "200",
-                         "--seed", "3", "--outputs", "velocities", "--no-progress")
+    code, out, err = run(
+        capsys,
+        "sample",
+        US_SCENE,
+        "--dist",
+        "e=uniform:0:0.3",
+        "-n",
+        "200",
+        "--seed",
+        "3",
+        "--outputs",
+        "velocities",
+        "--no-progress",
+    )
     assert (code, err) == (0, "")
     rows = {line.split()[0]: line.split() for line in out.splitlines()[2:]}
     assert set(rows) == {"V1x", "V1y", "W1", "V2x", "V2y", "W2"}
     assert rows["W1"][1] == "[rad/s]" and rows["V1x"][1] == "[ft/s]"
-    frame = impactsym.sample(US_SCENE, {"e": ("uniform", 0, 0.3)}, 200, seed=3,
-                             outputs="velocities")
+    frame = impactsym.sample(US_SCENE, {"e": ("uniform", 0, 0.3)}, 200, seed=3, outputs="velocities")
     assert float(rows["V2y"][4]) == pytest.approx(np.percentile(frame["V2y"], 50), rel=1e-5)
 
 
@@ -387,7 +438,7 @@ def test_compare_markdown_has_the_warnings_and_the_skipped_models(name, capsys):
 
 # --------------------------------------------------------------------------- 8. too large, interrupts
 
-HUGE = ["--vary", "e=0:1:1000000", "--vary", "mu=0:0.5:1000000"]   # 1e12 rows: never allocated
+HUGE = ["--vary", "e=0:1:1000000", "--vary", "mu=0:0.5:1000000"]  # 1e12 rows: never allocated
 
 
 def test_a_grid_too_large_for_the_temporary_disk_is_refused(capsys):
@@ -416,17 +467,29 @@ def test_the_limits_follow_what_the_machine_has(monkeypatch, tmp_path):
     assert len(impactsym.sweep(US_SCENE, e=np.linspace(0, 1, 10**4))) == 10**4
 
 
-@pytest.mark.parametrize("signal_name, code, said", [("SIGTERM", 143, "terminated"),
-                                                     ("SIGINT", 130, "interrupted")])
-def test_an_interrupted_sweep_leaves_no_spill_file_and_no_traceback(tmp_path, signal_name, code,
-                                                                    said):
+@pytest.mark.parametrize(
+    "signal_name, code, said", [("SIGTERM", 143, "terminated"), ("SIGINT", 130, "interrupted")]
+)
+def test_an_interrupted_sweep_leaves_no_spill_file_and_no_traceback(tmp_path, signal_name, code, said):
     temp = tmp_path / "tmp"
     temp.mkdir()
     # 1e6 rows in chunks of 500: about 20 s of work, interrupted once it spills.
     process = subprocess.Popen(
-        _cli("sweep", US_SCENE, "--vary", "e=0:1:1000", "--vary", "mu=0:0.5:1000",
-             "--chunk-size", "500", "--no-progress"),
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=_env(TMPDIR=str(temp)))
+        _cli(
+            "sweep",
+            US_SCENE,
+            "--vary",
+            "e=0:1:1000",
+            "--vary",
+            "mu=0:0.5:1000",
+            "--chunk-size",
+            "500",
+            "--no-progress",
+        ),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=_env(TMPDIR=str(temp)),
+    )
     try:
         deadline = time.monotonic() + 60
         while not any(temp.iterdir()) and time.monotonic() < deadline and process.poll() is None:

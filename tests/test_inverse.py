@@ -27,8 +27,15 @@ def _scenes(model, n=300, seed=5):
 
 def _speed_scale(c, fwd):
     """The scene's speed scale: the largest initial or final speed."""
-    return np.max([np.hypot(c["v1x"], c["v1y"]), np.hypot(c["v2x"], c["v2y"]),
-                   np.hypot(fwd["V1x"], fwd["V1y"]), np.hypot(fwd["V2x"], fwd["V2y"])], axis=0)
+    return np.max(
+        [
+            np.hypot(c["v1x"], c["v1y"]),
+            np.hypot(c["v2x"], c["v2y"]),
+            np.hypot(fwd["V1x"], fwd["V1y"]),
+            np.hypot(fwd["V2x"], fwd["V2y"]),
+        ],
+        axis=0,
+    )
 
 
 def _finals_as_inputs(c, fwd, model):
@@ -128,8 +135,9 @@ def test_round_trip_on_the_stress_scenes():
 
     columns, families = stress_set()
     fwd = impactsym.solve_batch(columns)
-    usable = ((fwd["status"] == 0) & (fwd["flags"] == 0) & (columns["e"] >= 0.05)
-              & (np.abs(columns["e_m"]) >= 0.05))
+    usable = (
+        (fwd["status"] == 0) & (fwd["flags"] == 0) & (columns["e"] >= 0.05) & (np.abs(columns["e_m"]) >= 0.05)
+    )
     assert len(set(families[usable])) >= 5, set(families[usable])
     inv = impactsym.invert_batch(_finals_as_inputs(columns, fwd, "rigid"))
     assert (inv["status"][usable] == 0).all()

@@ -18,8 +18,7 @@ from impactsym.testing.scenes import random_realistic
 
 ROOT = Path(__file__).resolve().parents[1]
 TWO_CAR = json.loads((ROOT / "examples" / "two_car_us.json").read_text())
-FINALS = ("V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M", "mu", "mu_c",
-          "TL", "TLn", "TLt", "TLm")
+FINALS = ("V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M", "mu", "mu_c", "TL", "TLn", "TLt", "TLm")
 COEFFICIENTS = ("e", "mu", "e_m")
 
 
@@ -117,18 +116,17 @@ def test_a_wrong_sideswipe_formula_fails_its_proof(monkeypatch):
     def wrong():
         blocks = good()
         first = blocks[0]
-        bad = tuple((s, x.xreplace({derive_presets.slip: derive_presets.slip / 2}))
-                    for s, x in first.assigns)
+        bad = tuple((s, x.xreplace({derive_presets.slip: derive_presets.slip / 2})) for s, x in first.assigns)
         return (type(first)(bad, first.guard),) + blocks[1:]
 
     monkeypatch.setattr(derive_presets, "_impulse_blocks", wrong)
     monkeypatch.setattr(derive_presets, "KERNELS", (derive_presets.sideswipe_kernel(),))
     results = dict(derive_presets._sideswipe_claims())
-    assert not results["impac_sideswipe: momentum, angular impulse and M = 0 hold; "
-                       "Gn = 0 and Gt = slip*gt"]
+    assert not results["impac_sideswipe: momentum, angular impulse and M = 0 hold; Gn = 0 and Gt = slip*gt"]
 
 
 # ---------------------------------------------------------------- scenes and CLI
+
 
 def scene_of(model, **impact):
     return {**TWO_CAR, "model": model, "impact": {"normal_angle": 0.0, **impact}}
@@ -177,8 +175,12 @@ def test_unknown_model_lists_the_names():
 
 
 def test_sideswipe_has_no_inverse():
-    data = {**scene_of("impac_sideswipe"), "vehicles": [
-        {**v, "final_velocity": v["velocity"], "final_yaw_rate": 0.0} for v in TWO_CAR["vehicles"]]}
+    data = {
+        **scene_of("impac_sideswipe"),
+        "vehicles": [
+            {**v, "final_velocity": v["velocity"], "final_yaw_rate": 0.0} for v in TWO_CAR["vehicles"]
+        ],
+    }
     with pytest.raises(SceneError, match="no inverse solution"):
         impactsym.invert(data)
 
@@ -203,8 +205,9 @@ def test_a_preset_scene_round_trips_through_to_dict():
     assert again.impact == scene.impact and again.warnings == ()
 
 
-@pytest.mark.parametrize("name", ["limpert_two_car_us.json", "macmillan_intersection_si.json",
-                                  "impac_sideswipe_si.json"])
+@pytest.mark.parametrize(
+    "name", ["limpert_two_car_us.json", "macmillan_intersection_si.json", "impac_sideswipe_si.json"]
+)
 def test_model_examples_solve_without_warnings(capsys, name):
     assert main(["solve", str(ROOT / "examples" / name), "--json"]) == 0
     out = json.loads(capsys.readouterr().out)

@@ -13,8 +13,11 @@ from impactsym.cli import main
 
 matplotlib.use("Agg")
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
-FORWARD = [p for p in sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml"))
-           if not p.name.startswith(("invert_", "reconstruct_", "crash3_"))]
+FORWARD = [
+    p
+    for p in sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml"))
+    if not p.name.startswith(("invert_", "reconstruct_", "crash3_"))
+]
 MIN_PNG_BYTES = 20_000  # a blank 9x6.5 in figure at 120 dpi is about 8 kB
 
 
@@ -30,16 +33,23 @@ def test_every_forward_example_renders_scene_and_result(path, tmp_path):
     _check_png(plot.save_plot(impactsym.solve(path), tmp_path / "result.png", scene=path))
 
 
-@pytest.mark.parametrize("make, name", [(impactsym.invert, "invert_two_car_si.json"),
-                                        (impactsym.reconstruct, "reconstruct_two_car_si.json")])
+@pytest.mark.parametrize(
+    "make, name",
+    [(impactsym.invert, "invert_two_car_si.json"), (impactsym.reconstruct, "reconstruct_two_car_si.json")],
+)
 def test_inverse_and_reconstruction_results_render(make, name, tmp_path):
     path = EXAMPLES / name
     _check_png(plot.save_plot(make(path), tmp_path / "out.png", scene=path))
 
 
-@pytest.mark.parametrize("command, name", [("solve", "barrier_si.json"),
-                                           ("invert", "invert_two_car_si.json"),
-                                           ("reconstruct", "reconstruct_two_car_si.json")])
+@pytest.mark.parametrize(
+    "command, name",
+    [
+        ("solve", "barrier_si.json"),
+        ("invert", "invert_two_car_si.json"),
+        ("reconstruct", "reconstruct_two_car_si.json"),
+    ],
+)
 def test_cli_plot_option_writes_the_diagram(command, name, tmp_path, capsys):
     out = tmp_path / "d.png"
     assert main([command, str(EXAMPLES / name), "--plot", str(out)]) == 0
@@ -53,6 +63,7 @@ def test_cli_plot_rejects_an_unknown_image_type(tmp_path, capsys):
 
 
 # --------------------------------------------------------------------------- geometry and API
+
 
 def _axes():
     from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -71,13 +82,17 @@ def test_import_impactsym_loads_neither_matplotlib_nor_ipywidgets():
     import subprocess
     import sys
 
-    code = ("import sys, impactsym; "
-            "assert not {'matplotlib', 'ipywidgets', 'sympy', 'derive'} & set(sys.modules), sys.modules.keys()")
+    code = (
+        "import sys, impactsym; "
+        "assert not {'matplotlib', 'ipywidgets', 'sympy', 'derive'} & set(sys.modules), sys.modules.keys()"
+    )
     subprocess.run([sys.executable, "-c", code], check=True)
 
 
 def test_centres_of_gravity_sit_at_minus_r_from_the_impact_centre():
-    ax = plot.scene(impactsym.solve(EXAMPLES / "two_car_us.json"), _axes(), scene=EXAMPLES / "two_car_us.json")
+    ax = plot.scene(
+        impactsym.solve(EXAMPLES / "two_car_us.json"), _axes(), scene=EXAMPLES / "two_car_us.json"
+    )
     assert _markers(ax, "X") == [(0.0, 0.0)]  # the impact centre at the origin
     cgs = _markers(ax, "+")
     assert cgs == [pytest.approx((-6.0, -1.0)), pytest.approx((1.5, 4.0))]
@@ -96,10 +111,15 @@ def test_impact_position_moves_the_whole_scene():
 def test_particles_are_placed_either_side_of_the_impact_centre_along_n():
     import math
 
-    data = {"model": "particle", "units": "SI",
-            "impact": {"normal_angle": 30.0, "restitution": 0.2, "impulse_ratio": 0.1},
-            "vehicles": [{"name": "a", "mass": 1.0, "velocity": [2.0, 1.0]},
-                         {"name": "b", "mass": 2.0, "velocity": [-1.0, 0.0]}]}
+    data = {
+        "model": "particle",
+        "units": "SI",
+        "impact": {"normal_angle": 30.0, "restitution": 0.2, "impulse_ratio": 0.1},
+        "vehicles": [
+            {"name": "a", "mass": 1.0, "velocity": [2.0, 1.0]},
+            {"name": "b", "mass": 2.0, "velocity": [-1.0, 0.0]},
+        ],
+    }
     ax = plot.scene(impactsym.solve(data), _axes(), scene=data)
     (x1, y1), (x2, y2) = _markers(ax, "+")
     n = (math.cos(math.radians(30.0)), math.sin(math.radians(30.0)))
@@ -110,8 +130,9 @@ def test_particles_are_placed_either_side_of_the_impact_centre_along_n():
 def test_outlines_barrier_and_legend_with_units():
     from matplotlib.patches import Polygon
 
-    ax = plot.scene(impactsym.solve(EXAMPLES / "intersection_si.toml"), _axes(),
-                    scene=EXAMPLES / "intersection_si.toml")
+    ax = plot.scene(
+        impactsym.solve(EXAMPLES / "intersection_si.toml"), _axes(), scene=EXAMPLES / "intersection_si.toml"
+    )
     outlines = [p for p in ax.patches if isinstance(p, Polygon) and len(p.get_xy()) == 5]
     assert len(outlines) == 2  # two rectangles (closed: 5 vertices)
     labels = [text.get_text() for text in ax.get_legend().get_texts()]
@@ -119,7 +140,9 @@ def test_outlines_barrier_and_legend_with_units():
     assert "delta-V [m/s]" in labels and any("yaw rate after [rad/s]" in label for label in labels)
     assert any(label.startswith("PDOF") for label in labels)
     assert ax.get_legend().get_title().get_text().startswith("arrows: 1 m = ")
-    barrier = plot.scene(impactsym.solve(EXAMPLES / "barrier_si.json"), _axes(), scene=EXAMPLES / "barrier_si.json")
+    barrier = plot.scene(
+        impactsym.solve(EXAMPLES / "barrier_si.json"), _axes(), scene=EXAMPLES / "barrier_si.json"
+    )
     assert any(p.get_hatch() for p in barrier.patches)
     assert "fixed barrier" in [text.get_text() for text in barrier.get_legend().get_texts()]
 
@@ -138,8 +161,13 @@ def test_a_duck_typed_result_is_drawn_with_its_scene():
 
     path = EXAMPLES / "two_car_us.json"
     solved = impactsym.solve(path)
-    fake = SimpleNamespace(vehicles=[SimpleNamespace(velocity=v.velocity, delta_v=v.delta_v, yaw_rate=v.yaw_rate)
-                                     for v in solved.vehicles], units="US")
+    fake = SimpleNamespace(
+        vehicles=[
+            SimpleNamespace(velocity=v.velocity, delta_v=v.delta_v, yaw_rate=v.yaw_rate)
+            for v in solved.vehicles
+        ],
+        units="US",
+    )
     ax = plot.scene(fake, _axes(), scene=path)  # no Pn/Pt: PDOF from the delta-V direction
     assert "velocity after [ft/s]" in [text.get_text() for text in ax.get_legend().get_texts()]
     with pytest.raises(TypeError, match="scene="):

@@ -24,11 +24,16 @@ from impactsym import plot
 
 matplotlib.use("Agg")
 EXAMPLES = FilePath(__file__).resolve().parent.parent / "examples"
-FORWARD = [p for p in sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml"))
-           if not p.name.startswith(("invert_", "reconstruct_", "crash3_"))]
-CASES = ([(impactsym.solve, p) for p in FORWARD]
-         + [(impactsym.invert, p) for p in sorted(EXAMPLES.glob("invert_*"))]
-         + [(impactsym.reconstruct, p) for p in sorted(EXAMPLES.glob("reconstruct_*"))])
+FORWARD = [
+    p
+    for p in sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml"))
+    if not p.name.startswith(("invert_", "reconstruct_", "crash3_"))
+]
+CASES = (
+    [(impactsym.solve, p) for p in FORWARD]
+    + [(impactsym.invert, p) for p in sorted(EXAMPLES.glob("invert_*"))]
+    + [(impactsym.reconstruct, p) for p in sorted(EXAMPLES.glob("reconstruct_*"))]
+)
 
 
 def _drawn(make, path):
@@ -37,8 +42,11 @@ def _drawn(make, path):
     ax = plot.scene(make(path), fig.add_subplot(), scene=path)
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
-    texts = [(t.get_text(), Text.get_window_extent(t, renderer))  # the text itself, not a leader line
-             for t in ax.texts if t.get_visible() and t.get_text()]
+    texts = [
+        (t.get_text(), Text.get_window_extent(t, renderer))  # the text itself, not a leader line
+        for t in ax.texts
+        if t.get_visible() and t.get_text()
+    ]
     return ax, texts
 
 
@@ -50,22 +58,30 @@ def test_no_two_texts_overlap_and_none_lies_on_an_arrow_or_an_outline(make, path
     assert not overlapping
     arrows = [p for p in ax.patches if isinstance(p, FancyArrowPatch)]
     assert len(arrows) >= 3
-    outlines = [p for p in ax.patches if isinstance(p, Polygon) and not p.get_hatch() and len(p.get_xy()) == 5]
+    outlines = [
+        p for p in ax.patches if isinstance(p, Polygon) and not p.get_hatch() and len(p.get_xy()) == 5
+    ]
     crossed = []
     for patch in arrows + outlines:
         drawn = patch.get_transform().transform_path(patch.get_path())
         # as polylines: intersects_bbox would take a CLOSEPOLY's placeholder vertex for a point
         parts = [Path(polygon) for polygon in drawn.to_polygons(closed_only=False) if len(polygon) > 1]
-        crossed += [(text, type(patch).__name__) for text, box in texts
-                    if any(part.intersects_bbox(box, filled=False) for part in parts)]
+        crossed += [
+            (text, type(patch).__name__)
+            for text, box in texts
+            if any(part.intersects_bbox(box, filled=False) for part in parts)
+        ]
     assert not crossed
 
 
 def test_every_label_stays_inside_the_axes():
     ax, texts = _drawn(impactsym.solve, EXAMPLES / "intersection_si.toml")
     frame = ax.bbox
-    outside = [text for text, box in texts if not (frame.x0 <= box.x0 and box.x1 <= frame.x1
-                                                  and frame.y0 <= box.y0 and box.y1 <= frame.y1)]
+    outside = [
+        text
+        for text, box in texts
+        if not (frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1)
+    ]
     assert not outside
 
 

@@ -223,8 +223,9 @@ def test_line_plot_of_several_columns(e_mu):
 # --------------------------------------------------------------------------- errors
 
 
-@pytest.mark.parametrize("args, name", [(("speed", "mu"), "speed"), (("e", "nope"), "nope"),
-                                        (("e", "mu", "energy"), "energy")])
+@pytest.mark.parametrize(
+    "args, name", [(("speed", "mu"), "speed"), (("e", "nope"), "nope"), (("e", "mu", "energy"), "energy")]
+)
 def test_unknown_column_is_named(e_mu, args, name):
     with pytest.raises(ValueError, match=f"^{name}: no such column"):
         plot_sweep.sweep(e_mu, *args, ax=_axes())

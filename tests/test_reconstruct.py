@@ -19,8 +19,7 @@ def _forward_then_columns(n=300, seed=21):
     c = scenes.random_realistic(n, seed=seed)
     fwd = impactsym.solve_batch(c)
     speed1, speed2 = np.hypot(c["v1x"], c["v1y"]), np.hypot(c["v2x"], c["v2y"])
-    cols = {k: c[k] for k in ("m1", "m2", "I1", "I2", "w1", "w2", "r1x", "r1y", "r2x", "r2y",
-                              "gamma")}
+    cols = {k: c[k] for k in ("m1", "m2", "I1", "I2", "w1", "w2", "r1x", "r1y", "r2x", "r2y", "gamma")}
     cols.update({k: fwd[k] for k in ("V1x", "V1y", "W1", "V2x", "V2y", "W2")})
     cols["theta1"] = np.arctan2(c["v1y"], c["v1x"])
     cols["theta2"] = np.arctan2(c["v2y"], c["v2x"])
@@ -38,8 +37,9 @@ def test_reconstruction_recovers_speeds_and_coefficients():
     assert np.max(np.abs(rec["s1"][usable] - speed1[usable]) / scale) < 1e-9
     assert np.max(np.abs(rec["s2"][usable] - speed2[usable]) / scale) < 1e-9
     np.testing.assert_allclose(rec["e"][usable], c["e"][usable], rtol=0, atol=1e-8)
-    np.testing.assert_allclose(rec["mu"][usable], c["mu"][usable], rtol=0,
-                               atol=1e-8 * np.maximum(1, np.abs(c["mu"][usable])).max())
+    np.testing.assert_allclose(
+        rec["mu"][usable], c["mu"][usable], rtol=0, atol=1e-8 * np.maximum(1, np.abs(c["mu"][usable])).max()
+    )
     np.testing.assert_allclose(rec["mu_c"][usable], fwd["mu_c"][usable], rtol=1e-6)
     moment_scale = np.abs(fwd["Pn"][usable]) * 3.0
     assert np.max(np.abs(rec["M"][usable] - fwd["M"][usable]) / moment_scale) < 1e-9
@@ -59,8 +59,15 @@ def test_collinear_headings_are_refused_and_other_rows_solved():
 def test_cli_reconstruct_prints_the_documented_object(capsys):
     assert main(["reconstruct", "examples/reconstruct_two_car_si.json", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    for key in ("vehicles", "impulse", "restitution", "impulse_ratio",
-                "critical_impulse_ratio", "energy_loss", "warnings"):
+    for key in (
+        "vehicles",
+        "impulse",
+        "restitution",
+        "impulse_ratio",
+        "critical_impulse_ratio",
+        "energy_loss",
+        "warnings",
+    ):
         assert key in out, key
     for vehicle in out["vehicles"]:
         assert {"speed", "velocity", "delta_v", "delta_v_magnitude"} <= set(vehicle)

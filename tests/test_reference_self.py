@@ -46,6 +46,7 @@ def _solved(columns, model):
 
 # ---------------------------------------------------------------- helpers (own algebra)
 
+
 def _mp(row, key, default=0.0):
     return mp.mpf(row.get(key, default))
 
@@ -58,8 +59,9 @@ def _velocity_state(row, ref=None):
             v = (_mp(row, f"v{i}x"), _mp(row, f"v{i}y"), _mp(row, f"w{i}"))
         else:
             v = (ref[f"V{i}x"], ref[f"V{i}y"], ref[f"W{i}"])
-        out.append((_mp(row, f"m{i}"), _mp(row, f"I{i}", math.inf), *v,
-                    _mp(row, f"r{i}x"), _mp(row, f"r{i}y")))
+        out.append(
+            (_mp(row, f"m{i}"), _mp(row, f"I{i}", math.inf), *v, _mp(row, f"r{i}x"), _mp(row, f"r{i}y"))
+        )
     return out
 
 
@@ -99,18 +101,18 @@ def _kinetic(row, ref):
     T = mp.zero
     for m, I, vx, vy, w, _rx, _ry in _velocity_state(row, ref):
         if mp.isfinite(m):
-            T += m * (vx ** 2 + vy ** 2) / 2
+            T += m * (vx**2 + vy**2) / 2
         if mp.isfinite(I):
-            T += I * w ** 2 / 2
+            T += I * w**2 / 2
     return T
 
 
 def _speed(row):
-    return max(mp.hypot(_mp(row, "v1x"), _mp(row, "v1y")),
-               mp.hypot(_mp(row, "v2x"), _mp(row, "v2y")))
+    return max(mp.hypot(_mp(row, "v1x"), _mp(row, "v1y")), mp.hypot(_mp(row, "v2x"), _mp(row, "v2y")))
 
 
 # ---------------------------------------------------------------- seed Table 2
+
 
 def test_table2_energy_loss():
     """Seed Table 2: T_L of the example particle impact, exact to 1e-9 relative."""
@@ -148,7 +150,7 @@ def test_particle_closed_forms(particle):
             r = gt / gn
             e, mu = _mp(row, "e"), _mp(row, "mu")
             mbar = _mp(row, "m1") * _mp(row, "m2") / (_mp(row, "m1") + _mp(row, "m2"))
-            tl = mbar * (1 + e) * gn ** 2 / 2 * ((1 - e) + 2 * mu * r - mu ** 2 * (1 + e))
+            tl = mbar * (1 + e) * gn**2 / 2 * ((1 - e) + 2 * mu * r - mu**2 * (1 + e))
             assert abs(ref["mu_c"] - r / (1 + e)) <= TIGHT * (1 + abs(r)), f"row {i}: mu_c"
             assert abs(crit["mu"] - r / (1 + e)) <= TIGHT * (1 + abs(r)), f"row {i}: critical mu"
             scale = _kinetic(row, None)
@@ -156,6 +158,7 @@ def test_particle_closed_forms(particle):
 
 
 # ---------------------------------------------------------------- conservation laws
+
 
 @pytest.mark.parametrize("mode", ["given", "critical"])
 def test_momentum_conservation(rigid, particle, mode):
@@ -171,7 +174,8 @@ def test_momentum_conservation(rigid, particle, mode):
                     for what, a, b in (("px", px0, px1), ("py", py0, py1), ("L", L0, L1)):
                         assert abs(a - b) <= TIGHT * scale, (
                             f"{name} row {i} {mode}: {what} not conserved, "
-                            f"{mp.nstr(a, 20)} -> {mp.nstr(b, 20)}")
+                            f"{mp.nstr(a, 20)} -> {mp.nstr(b, 20)}"
+                        )
 
 
 def test_impulse_matches_velocity_changes(rigid, barrier):
@@ -189,10 +193,12 @@ def test_impulse_matches_velocity_changes(rigid, barrier):
                 moment = _mp(row, "r1x") * Py - _mp(row, "r1y") * Px + ref["M"]
                 lever = mp.hypot(_mp(row, "r1x"), _mp(row, "r1y"))
                 assert abs(I1 * (ref["W1"] - _mp(row, "w1")) - moment) <= TIGHT * (
-                    scale * lever + abs(ref["M"])), f"row {i}: angular impulse"
+                    scale * lever + abs(ref["M"])
+                ), f"row {i}: angular impulse"
 
 
 # ---------------------------------------------------------------- constitutive equations
+
 
 def test_restitution_ratio_and_moment(rigid):
     """n.(U2-U1) = -e n.(u2-u1); Pt = mu Pn; (W2-W1)(1-e_m) = e_m M (1/I1 + 1/I2)."""
@@ -215,8 +221,7 @@ def test_restitution_ratio_and_moment(rigid):
 
 def test_mu_c_makes_tangential_velocity_zero(rigid, particle, barrier):
     """Solving with mu = mu_c (impulse-ratio form) stops sliding: Gt = 0 at separation."""
-    for name, (rows, _, crits) in (("rigid", rigid), ("particle", particle),
-                                   ("barrier", barrier)):
+    for name, (rows, _, crits) in (("rigid", rigid), ("particle", particle), ("barrier", barrier)):
         model = "particle" if name == "particle" else "rigid"
         for i, (row, crit) in enumerate(zip(rows, crits)):
             at_mu_c = R.solve_reference(dict(row, mu=crit["mu_c"]), model, critical=False)
@@ -227,27 +232,31 @@ def test_mu_c_makes_tangential_velocity_zero(rigid, particle, barrier):
                 assert abs(Gn + _mp(row, "e") * gn) <= TIGHT * _speed(row)
                 for key in ("V1x", "V1y", "W1", "V2x", "V2y", "W2"):
                     assert abs(at_mu_c[key] - crit[key]) <= TIGHT * (_speed(row) + 1), (
-                        f"{name} row {i}: {key} of mu = mu_c differs from the critical solve")
+                        f"{name} row {i}: {key} of mu = mu_c differs from the critical solve"
+                    )
 
 
 # ---------------------------------------------------------------- energy
 
+
 def test_energy_partition_sums_to_ke_difference(rigid, particle, barrier):
     """TLn + TLt + TLm = TL (a 50-digit kinetic-energy difference) to 40 digits of KE0."""
-    for name, (rows, refs, crits) in (("rigid", rigid), ("particle", particle),
-                                      ("barrier", barrier)):
+    for name, (rows, refs, crits) in (("rigid", rigid), ("particle", particle), ("barrier", barrier)):
         with mp.workdps(R.DPS):
             for i, row in enumerate(rows):
                 for ref in (refs[i], crits[i]):
                     ke0 = _kinetic(row, None)
                     assert abs(ke0 - _kinetic(row, ref) - ref["TL"]) <= TIGHT * ke0, (
-                        f"{name} row {i}: TL is not the kinetic-energy difference")
+                        f"{name} row {i}: TL is not the kinetic-energy difference"
+                    )
                     parts = ref["TLn"] + ref["TLt"] + ref["TLm"]
                     assert abs(parts - ref["TL"]) <= TIGHT * ke0, (
-                        f"{name} row {i}: TLn+TLt+TLm = {parts} but TL = {ref['TL']}")
+                        f"{name} row {i}: TLn+TLt+TLm = {parts} but TL = {ref['TL']}"
+                    )
 
 
 # ---------------------------------------------------------------- fixed body
+
 
 def test_fixed_body_stays_put(barrier):
     """A fixed barrier (m2 = I2 = inf) keeps its velocity, also when it moves."""
@@ -255,8 +264,12 @@ def test_fixed_body_stays_put(barrier):
     with mp.workdps(R.DPS):
         for i, row in enumerate(rows):
             moving = dict(row, v2x=1.25, v2y=-0.5, w2=0.125)
-            cases = ((row, refs[i]), (row, crits[i]), (moving, R.solve_reference(moving)),
-                     (moving, R.solve_reference(moving, critical=True)))
+            cases = (
+                (row, refs[i]),
+                (row, crits[i]),
+                (moving, R.solve_reference(moving)),
+                (moving, R.solve_reference(moving, critical=True)),
+            )
             for src, ref in cases:
                 for key, init in (("V2x", "v2x"), ("V2y", "v2y"), ("W2", "w2")):
                     assert abs(ref[key] - _mp(src, init)) <= TIGHT, f"row {i}: {key} moved"
@@ -278,13 +291,19 @@ def test_fixed_body_is_the_heavy_limit(barrier):
 
 def test_particle_into_wall_closed_form():
     """Particle at (10, 3) m/s into a wall along x: V1 = (-e*10, 3 + mu*Pn/m1)."""
-    row = dict(m1=2.0, m2=math.inf, v1x=10.0, v1y=3.0, v2x=0.0, v2y=0.0,
-               gamma=0.0, e=0.25, mu=0.125)
+    row = dict(m1=2.0, m2=math.inf, v1x=10.0, v1y=3.0, v2x=0.0, v2y=0.0, gamma=0.0, e=0.25, mu=0.125)
     ref = R.solve_reference(row, "particle")
     with mp.workdps(R.DPS):
         pn = -2 * (1 + mp.mpf(0.25)) * 10  # m1 (1+e) gn, gn = -10
-        expect = dict(V1x=-mp.mpf(2.5), V1y=3 + mp.mpf(0.125) * pn / 2, V2x=0, V2y=0, Pn=pn,
-                      Pt=mp.mpf(0.125) * pn, mu_c=mp.mpf(6) / 25)  # sticking: Pt = -m1*3, Pn = -25
+        expect = dict(
+            V1x=-mp.mpf(2.5),
+            V1y=3 + mp.mpf(0.125) * pn / 2,
+            V2x=0,
+            V2y=0,
+            Pn=pn,
+            Pt=mp.mpf(0.125) * pn,
+            mu_c=mp.mpf(6) / 25,
+        )  # sticking: Pt = -m1*3, Pn = -25
         for key, value in expect.items():
             assert abs(ref[key] - value) < TIGHT * 10, f"{key}: {ref[key]} != {value}"
         tl = (ref["V1x"] ** 2 + ref["V1y"] ** 2 - 109) * -1  # m1/2 = 1
@@ -292,6 +311,7 @@ def test_particle_into_wall_closed_form():
 
 
 # ---------------------------------------------------------------- the helpers themselves
+
 
 def test_checks_detect_a_wrong_solution(rigid):
     """The conservation check above fails for a 1e-12 perturbation (so it is not vacuous)."""

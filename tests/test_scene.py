@@ -14,10 +14,22 @@ BASE = {
     "units": "US",
     "impact": {"normal_angle": 0.0, "restitution": 0.1, "impulse_ratio": 0.3, "moment_restitution": 1.0},
     "vehicles": [
-        {"name": "car 1", "mass": 100.0, "yaw_inertia": 1800.0,
-         "velocity": [50.0, 0.0], "yaw_rate": 0.0, "impact_point": [6.0, 1.0]},
-        {"name": "car 2", "mass": 150.0, "yaw_inertia": 2600.0,
-         "velocity": [0.0, 30.0], "yaw_rate": 0.0, "impact_point": [-1.5, -4.0]},
+        {
+            "name": "car 1",
+            "mass": 100.0,
+            "yaw_inertia": 1800.0,
+            "velocity": [50.0, 0.0],
+            "yaw_rate": 0.0,
+            "impact_point": [6.0, 1.0],
+        },
+        {
+            "name": "car 2",
+            "mass": 150.0,
+            "yaw_inertia": 2600.0,
+            "velocity": [0.0, 30.0],
+            "yaw_rate": 0.0,
+            "impact_point": [-1.5, -4.0],
+        },
     ],
 }
 
@@ -103,7 +115,7 @@ BAD_VALUES = [
     (("impact", "moment_restitution"), None, "impact.moment_restitution", "finite"),
     (("impact",), 3.0, "impact", "object"),
     (("impact",), MISSING, "impact", "missing"),
-    (("units",), "metric", "units", "unknown units 'metric' (use \"SI\" or \"US\")"),
+    (("units",), "metric", "units", 'unknown units \'metric\' (use "SI" or "US")'),
     (("units",), MISSING, "units", "missing"),
     (("model",), "soft", "model", "unknown model"),
 ]
@@ -199,10 +211,24 @@ def test_inputs_of_the_conventions_scene():
     model, critical, values = load_scene(BASE).to_inputs()
     assert (model, critical) == ("rigid", False)
     assert values == {
-        "m1": 100.0, "m2": 150.0, "I1": 1800.0, "I2": 2600.0,
-        "v1x": 50.0, "v1y": 0.0, "w1": 0.0, "v2x": 0.0, "v2y": 30.0, "w2": 0.0,
-        "r1x": 6.0, "r1y": 1.0, "r2x": -1.5, "r2y": -4.0,
-        "gamma": 0.0, "e": 0.1, "mu": 0.3, "e_m": 1.0,
+        "m1": 100.0,
+        "m2": 150.0,
+        "I1": 1800.0,
+        "I2": 2600.0,
+        "v1x": 50.0,
+        "v1y": 0.0,
+        "w1": 0.0,
+        "v2x": 0.0,
+        "v2y": 30.0,
+        "w2": 0.0,
+        "r1x": 6.0,
+        "r1y": 1.0,
+        "r2x": -1.5,
+        "r2y": -4.0,
+        "gamma": 0.0,
+        "e": 0.1,
+        "mu": 0.3,
+        "e_m": 1.0,
     }
     assert all(type(value) is float for value in values.values())
 
@@ -288,15 +314,20 @@ def test_documented_extras_are_kept_and_unused_keys_reported():
     assert extra["heading"] == 0.0 and extra["final_velocity"] == (20.0, 5.0) and extra["crush"] == {"A": 1.0}
     assert scene.extra == {"description": "a test"}
     assert [w.split(" is given")[0] for w in scene.warnings] == [
-        "vehicles[0].final_velocity", "vehicles[0].crush"]
+        "vehicles[0].final_velocity",
+        "vehicles[0].crush",
+    ]
 
 
-@pytest.mark.parametrize(("where", "key", "suggestion"), [
-    (("impact",), "restitusion", "restitution"),
-    (("vehicles", 0), "yaw_rat", "yaw_rate"),
-    ((), "unit", "units"),
-    (("impact",), "moment_restitutoin", "moment_restitution"),
-])
+@pytest.mark.parametrize(
+    ("where", "key", "suggestion"),
+    [
+        (("impact",), "restitusion", "restitution"),
+        (("vehicles", 0), "yaw_rat", "yaw_rate"),
+        ((), "unit", "units"),
+        (("impact",), "moment_restitutoin", "moment_restitution"),
+    ],
+)
 def test_unknown_key_is_an_error_with_a_suggestion(where, key, suggestion):
     data = copy.deepcopy(BASE)
     target = data
@@ -312,8 +343,9 @@ def test_unknown_key_is_an_error_with_a_suggestion(where, key, suggestion):
 def test_load_scene_accepts_a_scene_and_revalidates_it():
     scene = load_scene(BASE)
     assert load_scene(scene) == scene
-    bad = Scene(scene.model, scene.units, scene.impact,
-                (scene.vehicles[0], Vehicle("car 2", -1.0, 1.0, (0.0, 0.0))))
+    bad = Scene(
+        scene.model, scene.units, scene.impact, (scene.vehicles[0], Vehicle("car 2", -1.0, 1.0, (0.0, 0.0)))
+    )
     with pytest.raises(SceneError, match=r"^vehicles\[1\]\.mass: "):
         load_scene(bad)
 

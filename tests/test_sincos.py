@@ -60,8 +60,9 @@ def _check(name, xs):
     xs = [float(x) for x in xs]
     s, c = batch(xs)
     py = np.array([sincos_py(x) for x in xs])
-    assert np.array_equal(_bits(py[:, 0]), _bits(s)) and np.array_equal(_bits(py[:, 1]), _bits(c)), \
+    assert np.array_equal(_bits(py[:, 0]), _bits(s)) and np.array_equal(_bits(py[:, 1]), _bits(c)), (
         f"{name}: numba batch differs from plain Python"
+    )
     err_s, err_c = trig.ulp_errors(sincos_py, xs)
     print(f"\n{name}: {len(xs)} points, max error sin {err_s:.3f} ulp, cos {err_c:.3f} ulp")
     assert err_s <= 1.0 and err_c <= 1.0, f"{name}: sin {err_s} ulp, cos {err_c} ulp"
@@ -69,6 +70,7 @@ def _check(name, xs):
 
 
 # ------------------------------------------------------------------ accuracy
+
 
 def test_scene_angles():
     """Angles a scene gives: degrees in [-360, 360] (every integer and half degree,
@@ -95,8 +97,18 @@ def test_near_multiples_of_half_and_quarter_pi():
 def test_tiny_arguments():
     rng = random.Random(3)
     xs = [sgn * 10.0 ** rng.uniform(-323, -1) for sgn in (1, -1) for _ in range(1000)]
-    xs += [5e-324, -5e-324, 2.2250738585072014e-308, -2.2250738585072014e-308, 1e-300, -1e-300,
-           2.0**-27, -(2.0**-27), 2.0**-26, 1e-8]
+    xs += [
+        5e-324,
+        -5e-324,
+        2.2250738585072014e-308,
+        -2.2250738585072014e-308,
+        1e-300,
+        -1e-300,
+        2.0**-27,
+        -(2.0**-27),
+        2.0**-26,
+        1e-8,
+    ]
     _check("tiny |x| (subnormal .. 0.1)", xs)
 
 
@@ -123,18 +135,32 @@ def test_limit_is_where_the_quadrant_count_reaches_2_pow_20():
 
 # ------------------------------------------------------------------ special values
 
+
 def _same(got, want):
-    return all((math.isnan(g) and math.isnan(w)) or (g == w and math.copysign(1, g) == math.copysign(1, w))
-               for g, w in zip(got, want))
+    return all(
+        (math.isnan(g) and math.isnan(w)) or (g == w and math.copysign(1, g) == math.copysign(1, w))
+        for g, w in zip(got, want)
+    )
 
 
 @pytest.mark.parametrize("fn", [sincos_py, sincos_jit], ids=["python", "numba"])
-@pytest.mark.parametrize(("x", "want"), [
-    (0.0, (0.0, 1.0)), (-0.0, (-0.0, 1.0)),
-    (math.inf, (math.nan, math.nan)), (-math.inf, (math.nan, math.nan)), (math.nan, (math.nan, math.nan)),
-    (5e-324, (5e-324, 1.0)), (-5e-324, (-5e-324, 1.0)), (1e-300, (1e-300, 1.0)), (-1e-300, (-1e-300, 1.0)),
-    (1e-9, (1e-9, 1.0)), (-(2.0**-28), (-(2.0**-28), 1.0)),
-], ids=repr)
+@pytest.mark.parametrize(
+    ("x", "want"),
+    [
+        (0.0, (0.0, 1.0)),
+        (-0.0, (-0.0, 1.0)),
+        (math.inf, (math.nan, math.nan)),
+        (-math.inf, (math.nan, math.nan)),
+        (math.nan, (math.nan, math.nan)),
+        (5e-324, (5e-324, 1.0)),
+        (-5e-324, (-5e-324, 1.0)),
+        (1e-300, (1e-300, 1.0)),
+        (-1e-300, (-1e-300, 1.0)),
+        (1e-9, (1e-9, 1.0)),
+        (-(2.0**-28), (-(2.0**-28), 1.0)),
+    ],
+    ids=repr,
+)
 def test_special_and_exact_values(fn, x, want):
     assert _same(fn(x), want), fn(x)
 
@@ -160,10 +186,16 @@ def test_pythagoras_and_symmetry(x):
 
 # ------------------------------------------------------------------ numba
 
+
 def test_python_and_numba_are_bitwise_identical():
     rng = np.random.default_rng(5)
-    xs = np.concatenate([rng.uniform(-7, 7, 3001), rng.uniform(-LIMIT, LIMIT, 3001),
-                         np.ldexp(rng.uniform(-1, 1, 1001), rng.integers(-1074, 0, 1001))])
+    xs = np.concatenate(
+        [
+            rng.uniform(-7, 7, 3001),
+            rng.uniform(-LIMIT, LIMIT, 3001),
+            np.ldexp(rng.uniform(-1, 1, 1001), rng.integers(-1074, 0, 1001)),
+        ]
+    )
     s, c = batch(xs)
     py = np.array([sincos_py(float(x)) for x in xs])
     scalar = np.array([sincos_jit(float(x)) for x in xs[:500]])
@@ -186,8 +218,10 @@ def test_prange_loop_is_simd_and_calls_no_libm():
     the same loop with math.sin/math.cos does call libm (so the check can fail)."""
     asm = _asm(sincos_prange)
     packed = len(_PACKED.findall(asm))
-    print(f"\nprange _sincos loop: {packed} packed float64 arithmetic instructions, "
-          f"{len(re.findall(r'vblendvpd', asm))} vblendvpd (quadrant selects)")
+    print(
+        f"\nprange _sincos loop: {packed} packed float64 arithmetic instructions, "
+        f"{len(re.findall(r'vblendvpd', asm))} vblendvpd (quadrant selects)"
+    )
     assert packed >= 40, packed
     assert not _LIBM_CALL.search(asm)
     assert _LIBM_CALL.search(_asm(libm_prange))
@@ -205,6 +239,7 @@ def test_source_is_deterministic_and_exactly_the_derived_constants():
 
 
 # ------------------------------------------------------------------ exhaustive (slow)
+
 
 @pytest.mark.slow
 def test_every_multiple_of_half_pi_up_to_the_limit():

@@ -163,7 +163,7 @@ PARTICLE_COLUMNS = ("m1", "m2", "v1x", "v1y", "v2x", "v2y", "gamma", "e", "mu")
 
 def _row_alone(models, cols, i):
     model = models[i]
-    row = {k: np.asarray(v)[i:i + 1] for k, v in cols.items()}
+    row = {k: np.asarray(v)[i : i + 1] for k, v in cols.items()}
     mu = row["mu"][0]
     row["mu"] = "critical" if mu == "critical" else np.array([float(mu)])
     if model in ("limpert", "macmillan"):
@@ -187,8 +187,9 @@ def test_mixed_batch_keeps_row_order(rigid, particle):
         alone = _row_alone(models, cols, i)
         assert (out["status"][i], out["flags"][i]) == (alone["status"][0], alone["flags"][0]), i
         for name in out:
-            np.testing.assert_allclose(out[name][i], alone[name][0], rtol=4e-15, atol=4e-15,
-                                       err_msg=f"row {i} ({models[i]}) {name}")
+            np.testing.assert_allclose(
+                out[name][i], alone[name][0], rtol=4e-15, atol=4e-15, err_msg=f"row {i} ({models[i]}) {name}"
+            )
 
 
 def test_mixed_batch_dataframe_index(rigid, particle):
@@ -240,8 +241,8 @@ def test_delta_v_is_the_velocity_change(rigid):
 
 def test_serial_and_parallel_drivers_agree(rigid):
     """Below SERIAL_BELOW rows the serial twin runs; it computes the same numbers."""
-    small = {k: v[:_kernels.SERIAL_BELOW - 1] for k, v in rigid.items()}
+    small = {k: v[: _kernels.SERIAL_BELOW - 1] for k, v in rigid.items()}
     big = impactsym.solve_batch(rigid)
     part = impactsym.solve_batch(small)
     for name in part:
-        np.testing.assert_array_equal(part[name], big[name][:_kernels.SERIAL_BELOW - 1])
+        np.testing.assert_array_equal(part[name], big[name][: _kernels.SERIAL_BELOW - 1])

@@ -66,6 +66,7 @@ WORST: dict = {}
 
 # =============================================================================== helpers
 
+
 def _solve(columns, model, critical=False):
     """Call the package (mu = "critical" in critical mode); {key: array} plus status/flags.
 
@@ -104,8 +105,12 @@ def _repeat_rows(columns, reps):
 
 def _mu_c(columns, model):
     """Reference mu_c of every row (float64)."""
-    return np.array([float(R.mu_critical(R.row_of(dict(columns, mu="critical"), i), model))
-                     for i in range(R.n_rows(columns))])
+    return np.array(
+        [
+            float(R.mu_critical(R.row_of(dict(columns, mu="critical"), i), model))
+            for i in range(R.n_rows(columns))
+        ]
+    )
 
 
 def _set_mu_fraction(columns, model, fractions):
@@ -179,8 +184,9 @@ def _check(columns, model, critical, label, *, flags=True, out=None):
         refs.append(ref)
         status = int(out["status"][i])
         if status != 0:
-            problems.append(f"row {i}: status {status} "
-                            f"({impactsym.describe_status(status)}) for a valid scene")
+            problems.append(
+                f"row {i}: status {status} ({impactsym.describe_status(status)}) for a valid scene"
+            )
             continue
         got = {k: float(out[k][i]) for k in OUTPUT_KEYS}
         bad = [k for k, v in got.items() if not math.isfinite(v)]
@@ -192,9 +198,11 @@ def _check(columns, model, critical, label, *, flags=True, out=None):
             if key not in worst or not err <= worst[key][0]:
                 worst[key] = (err, i)
             if not err <= TOL:
-                problems.append(f"row {i}: {key} error {err:.3g} of scale "
-                                f"(got {got[key]!r}, ref {_fmt(ref[key])}, "
-                                f"scale {mp.nstr(scales[key], 6)})")
+                problems.append(
+                    f"row {i}: {key} error {err:.3g} of scale "
+                    f"(got {got[key]!r}, ref {_fmt(ref[key])}, "
+                    f"scale {mp.nstr(scales[key], 6)})"
+                )
         with mp.workdps(R.DPS):
             ke = R.initial_kinetic_energy(row, model)
             if abs(ref["TL"]) >= TL_SELF_FLOOR * ke and ref["TL"] != 0:
@@ -202,23 +210,25 @@ def _check(columns, model, critical, label, *, flags=True, out=None):
                 if "TL/TL" not in worst or not err <= worst["TL/TL"][0]:
                     worst["TL/TL"] = (err, i)
                 if not err <= TL_SELF_TOL:
-                    problems.append(f"row {i}: TL relative error {err:.3g} "
-                                    f"(got {got['TL']!r}, ref {_fmt(ref['TL'])})")
+                    problems.append(
+                        f"row {i}: TL relative error {err:.3g} (got {got['TL']!r}, ref {_fmt(ref['TL'])})"
+                    )
         if flags:
             must_set, must_clear = _expected_flags(row, ref, scales, model, critical)
             f = int(out["flags"][i])
             if f & must_set != must_set or f & must_clear:
-                problems.append(f"row {i}: flags {f}, must set {must_set}, must clear "
-                                f"{must_clear} (TL parts "
-                                f"{[mp.nstr(ref[k], 6) for k in ENERGY_LIKE]}, Pn "
-                                f"{mp.nstr(ref['Pn'], 6)}, mu {mp.nstr(ref['mu'], 8)}, "
-                                f"mu_c {mp.nstr(ref['mu_c'], 8)})")
+                problems.append(
+                    f"row {i}: flags {f}, must set {must_set}, must clear "
+                    f"{must_clear} (TL parts "
+                    f"{[mp.nstr(ref[k], 6) for k in ENERGY_LIKE]}, Pn "
+                    f"{mp.nstr(ref['Pn'], 6)}, mu {mp.nstr(ref['mu'], 8)}, "
+                    f"mu_c {mp.nstr(ref['mu_c'], 8)})"
+                )
     record = WORST.setdefault(label, {})
     for key, (err, _i) in worst.items():
         if key not in record or not err <= record[key]:
             record[key] = err
-    assert not problems, (f"{label}: {len(problems)} problems in {n} rows; first: "
-                          + "; ".join(problems[:6]))
+    assert not problems, f"{label}: {len(problems)} problems in {n} rows; first: " + "; ".join(problems[:6])
     return worst, refs, out
 
 
@@ -235,6 +245,7 @@ def _report():
 
 
 # =============================================================================== bases
+
 
 def _em_cycle(columns, values=EM_MAIN):
     """Every row once per e_m in ``values`` (e_m overridden)."""
@@ -352,10 +363,28 @@ def near_grazing_columns(model, barrier):
                         # v = u - w (-r_y, r_x), exact for these dyadic numbers
                         v1 = (u1[0] + w1 * r1[1], u1[1] - w1 * r1[0])
                         v2 = (u2[0] + w2 * r2[1], u2[1] - w2 * r2[0])
-                        rows.append(dict(m1=m1, m2=m2, I1=I1, I2=I2, v1x=v1[0], v1y=v1[1],
-                                         w1=w1, v2x=v2[0], v2y=v2[1], w2=w2, r1x=r1[0],
-                                         r1y=r1[1], r2x=r2[0], r2y=r2[1], gamma=gamma, e=e,
-                                         mu=mu, e_m=e_m))
+                        rows.append(
+                            dict(
+                                m1=m1,
+                                m2=m2,
+                                I1=I1,
+                                I2=I2,
+                                v1x=v1[0],
+                                v1y=v1[1],
+                                w1=w1,
+                                v2x=v2[0],
+                                v2y=v2[1],
+                                w2=w2,
+                                r1x=r1[0],
+                                r1y=r1[1],
+                                r2x=r2[0],
+                                r2y=r2[1],
+                                gamma=gamma,
+                                e=e,
+                                mu=mu,
+                                e_m=e_m,
+                            )
+                        )
     return _columns(rows, model)
 
 
@@ -453,8 +482,10 @@ POW2 = (-40, -12, 12, 40)
 def test_speed_scale_power_of_two_is_exact(base, kind, model, critical, k):
     """Velocities and yaw rates x 2^k: V, W, P, M x 2^k and energies x 2^2k bitwise;
     mu, mu_c, status and flags unchanged."""
-    cols = _concat(_em_cycle(base[kind]) if model == "rigid" else base[kind],
-                   near_grazing_columns(model, kind == "barrier"))
+    cols = _concat(
+        _em_cycle(base[kind]) if model == "rigid" else base[kind],
+        near_grazing_columns(model, kind == "barrier"),
+    )
     scaled = dict(cols)
     for key in ("v1x", "v1y", "w1", "v2x", "v2y", "w2"):
         if key in scaled:
@@ -466,8 +497,10 @@ def test_speed_scale_power_of_two_is_exact(base, kind, model, critical, k):
         power = 2 * k if key in ENERGY_LIKE else (0 if key in RATIO_LIKE else k)
         want = np.ldexp(a[key], power)
         bad = np.flatnonzero(want != b[key])
-        assert bad.size == 0, (f"{key} x 2^{power} not exact on rows {bad[:8].tolist()}: "
-                               f"{b[key][bad[:3]].tolist()} vs {want[bad[:3]].tolist()}")
+        assert bad.size == 0, (
+            f"{key} x 2^{power} not exact on rows {bad[:8].tolist()}: "
+            f"{b[key][bad[:3]].tolist()} vs {want[bad[:3]].tolist()}"
+        )
 
 
 @pytest.mark.parametrize("kind,model", KINDS, ids=KIND_IDS)
@@ -483,6 +516,7 @@ def test_speed_scale_decimal(base, kind, model, critical, scale):
 
 
 # =============================================================================== central impacts
+
 
 def central_columns(base_cols, yaw):
     """Rigid scenes with r1 = r2 = 0 (gamma flipped where needed to approach); yaw rates
@@ -505,9 +539,9 @@ def test_central_impacts(base, kind, yaw, critical):
     """Zero lever arms: accuracy, and the translational results equal the particle model's."""
     cols = central_columns(base[kind], yaw)
     cols = _set_mu_fraction(cols, "rigid", np.resize([0.0, 0.5, 1.0], R.n_rows(cols)))
-    _, refs, out = _check(cols, "rigid", critical,
-                          f"central {kind} {'yaw' if yaw else 'no yaw'} "
-                          f"{'crit' if critical else 'mu'}")
+    _, refs, out = _check(
+        cols, "rigid", critical, f"central {kind} {'yaw' if yaw else 'no yaw'} {'crit' if critical else 'mu'}"
+    )
     part = _solve({k: cols[k] for k in R.PARTICLE_INPUTS}, "particle", critical)
     for key in ("V1x", "V1y", "V2x", "V2y", "Pn", "Pt", "mu_c", "TLn", "TLt"):
         for i, ref in enumerate(refs):
@@ -521,11 +555,13 @@ def test_central_impacts(base, kind, yaw, critical):
 
 # =============================================================================== wild mu (tensile, flags)
 
+
 def test_wild_mu_flags(base):
     """mu far outside [0, mu_c] (either sign, |mu| up to 10): tensile impulses, energy
     creation and mu out of range are flagged on every row where the reference says so."""
-    cols = _repeat_rows(_concat(_em_cycle(base["rigid"]),
-                                {k: v for k, v in _em_cycle(base["barrier"]).items()}), 6)
+    cols = _repeat_rows(
+        _concat(_em_cycle(base["rigid"]), {k: v for k, v in _em_cycle(base["barrier"]).items()}), 6
+    )
     cols["mu"] = np.tile([-10.0, -3.0, -1.0, 1.0, 3.0, 10.0], R.n_rows(cols) // 6)
     out = _solve(cols, "rigid")
     problems, hits = [], {ENERGY_CREATED: 0, TENSILE: 0, MU_OUT_OF_RANGE: 0}
@@ -547,6 +583,7 @@ def test_wild_mu_flags(base):
 
 
 # =============================================================================== Kane-Levinson
+
 
 def kane_levinson_columns(n=300, seed=4242):
     """Random realistic rigid scenes as generated (mu a fraction of mu_c, half the rows with
@@ -571,18 +608,19 @@ def test_energy_created_with_mu_inside_range_is_flagged():
     created = []
     for i, ref in enumerate(refs):
         row = R.row_of(cols, i)
-        must_set, _ = _expected_flags(row, ref, R.natural_scales(row, ref, "rigid"),
-                                      "rigid", False)
+        must_set, _ = _expected_flags(row, ref, R.natural_scales(row, ref, "rigid"), "rigid", False)
         if must_set & ENERGY_CREATED:
             created.append(i)
     paradox = [i for i in created if i in set(physical_em.tolist())]
-    assert len(paradox) >= 5, (f"only {len(paradox)} energy-creating rows with "
-                               f"0 <= mu <= mu_c, 0 <= e_m <= 1: family too weak")
+    assert len(paradox) >= 5, (
+        f"only {len(paradox)} energy-creating rows with 0 <= mu <= mu_c, 0 <= e_m <= 1: family too weak"
+    )
     missed = [i for i in created if not out["flags"][i] & ENERGY_CREATED]
     assert not missed, f"energy-creating rows not flagged: {missed}"
 
 
 # =============================================================================== degenerate
+
 
 def _degenerate_rows(model, good):
     """(label, row, expected status) for bad rows, built from a good row dict."""
@@ -591,12 +629,24 @@ def _degenerate_rows(model, good):
     def add(label, status, **changes):
         cases.append((label, dict(good, **changes), status))
 
-    add("both fixed", 4, m1=math.inf, m2=math.inf, **({} if model == "particle"
-                                                     else dict(I1=math.inf, I2=math.inf)))
-    add("no approach (gn = 0)", 3, gamma=0.0, v1x=5.0, v2x=5.0,
-        **({} if model == "particle" else dict(w1=0.0, w2=0.0)))
-    add("separating", 3, gamma=0.0, v1x=-5.0, v2x=5.0,
-        **({} if model == "particle" else dict(w1=0.0, w2=0.0)))
+    add(
+        "both fixed",
+        4,
+        m1=math.inf,
+        m2=math.inf,
+        **({} if model == "particle" else dict(I1=math.inf, I2=math.inf)),
+    )
+    add(
+        "no approach (gn = 0)",
+        3,
+        gamma=0.0,
+        v1x=5.0,
+        v2x=5.0,
+        **({} if model == "particle" else dict(w1=0.0, w2=0.0)),
+    )
+    add(
+        "separating", 3, gamma=0.0, v1x=-5.0, v2x=5.0, **({} if model == "particle" else dict(w1=0.0, w2=0.0))
+    )
     for key in ("v1x", "v2y", "gamma", "e", "mu", "m1", "m2"):
         add(f"NaN {key}", 1, **{key: math.nan})
     add("inf velocity", 1, v1x=math.inf)
@@ -625,8 +675,7 @@ def test_degenerate_rows(base, model, critical):
     bad = _columns([row for _, row, _ in cases], model)
     # interleave: good, bad, good, bad, ...
     mixed = _concat(good, bad)
-    order = np.argsort(np.concatenate([np.arange(R.n_rows(good)) * 2.0,
-                                       np.arange(len(cases)) * 2.0 + 1.0]))
+    order = np.argsort(np.concatenate([np.arange(R.n_rows(good)) * 2.0, np.arange(len(cases)) * 2.0 + 1.0]))
     mixed = _take(mixed, order)
     is_good = order < R.n_rows(good)
     out = _solve(mixed, model, critical)
@@ -657,9 +706,26 @@ def test_degenerate_rows(base, model, critical):
 def test_given_mu_singular_system():
     """D = Knn + Knt mu = 0 exactly (m1 = I1 = 1, r1 = (1, 1), barrier, e_m = 1, mu = 2):
     status 4 and NaN outputs, no division by zero."""
-    row = dict(m1=1.0, m2=math.inf, I1=1.0, I2=math.inf, v1x=3.0, v1y=0.0, w1=0.0,
-               v2x=0.0, v2y=0.0, w2=0.0, r1x=1.0, r1y=1.0, r2x=0.0, r2y=0.0, gamma=0.0,
-               e=0.2, mu=2.0, e_m=1.0)
+    row = dict(
+        m1=1.0,
+        m2=math.inf,
+        I1=1.0,
+        I2=math.inf,
+        v1x=3.0,
+        v1y=0.0,
+        w1=0.0,
+        v2x=0.0,
+        v2y=0.0,
+        w2=0.0,
+        r1x=1.0,
+        r1y=1.0,
+        r2x=0.0,
+        r2y=0.0,
+        gamma=0.0,
+        e=0.2,
+        mu=2.0,
+        e_m=1.0,
+    )
     out = _solve(_columns([row], "rigid"), "rigid")
     assert int(out["status"][0]) == 4, out["status"]
     assert all(np.isnan(out[k][0]) for k in OUTPUT_KEYS)
@@ -680,16 +746,24 @@ def test_overflow_is_a_status_not_inf():
 
 # =============================================================================== hypothesis
 
-HYP = settings(deadline=None, max_examples=25, derandomize=True,
-               # no shrinking: each example costs tens of 50-digit solves, and a failing
-               # example already reports its rows; keeps the module under 2 minutes
-               phases=(Phase.explicit, Phase.generate),
-               suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+HYP = settings(
+    deadline=None,
+    max_examples=25,
+    derandomize=True,
+    # no shrinking: each example costs tens of 50-digit solves, and a failing
+    # example already reports its rows; keeps the module under 2 minutes
+    phases=(Phase.explicit, Phase.generate),
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
 
 
 @HYP
-@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 16),
-       kind=st.sampled_from(KIND_IDS), critical=st.booleans())
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n=st.integers(1, 16),
+    kind=st.sampled_from(KIND_IDS),
+    critical=st.booleans(),
+)
 def test_random_realistic_hypothesis(seed, n, kind, critical):
     """Random realistic two-car (and barrier) scenes, whole arrays per example."""
     model = "particle" if kind == "particle" else "rigid"
@@ -706,16 +780,24 @@ def stress_mix(draw):
     seed = draw(st.integers(0, 2**32 - 1))
     row_floats = lambda lo, hi: hnp.arrays(np.float64, n, elements=st.floats(lo, hi))  # noqa: E731
     row_pick = lambda values: hnp.arrays(np.float64, n, elements=st.sampled_from(values))  # noqa: E731
-    return dict(seed=seed, n=n, mass=draw(row_floats(-9, 9)), inertia1=draw(row_floats(-8, 8)),
-                inertia2=draw(row_floats(-8, 8)), speed=draw(row_floats(-6, 6)),
-                e=draw(row_pick([0.0, 0.25, 0.5, 1.0 - 2.0**-20, 1.0])),
-                # μ strictly below μ_c: exactly at μ_c with a yaw inertia near 1e-8 of
-                # the usual the sliding problem itself is ill-conditioned in μ (one ulp
-                # of μ moves the 50-digit answer by ~5e-9, measured for seed 88974308),
-                # so no float64 method can meet 1e-12 there. μ = μ_c with ordinary
-                # inertias is covered by test_mu_at_and_below_critical.
-                e_m=draw(row_pick(list(EM_MAIN))), frac=draw(row_floats(0.0, 0.999)),
-                critical=draw(st.booleans()), barrier=draw(st.booleans()))
+    return dict(
+        seed=seed,
+        n=n,
+        mass=draw(row_floats(-9, 9)),
+        inertia1=draw(row_floats(-8, 8)),
+        inertia2=draw(row_floats(-8, 8)),
+        speed=draw(row_floats(-6, 6)),
+        e=draw(row_pick([0.0, 0.25, 0.5, 1.0 - 2.0**-20, 1.0])),
+        # μ strictly below μ_c: exactly at μ_c with a yaw inertia near 1e-8 of
+        # the usual the sliding problem itself is ill-conditioned in μ (one ulp
+        # of μ moves the 50-digit answer by ~5e-9, measured for seed 88974308),
+        # so no float64 method can meet 1e-12 there. μ = μ_c with ordinary
+        # inertias is covered by test_mu_at_and_below_critical.
+        e_m=draw(row_pick(list(EM_MAIN))),
+        frac=draw(row_floats(0.0, 0.999)),
+        critical=draw(st.booleans()),
+        barrier=draw(st.booleans()),
+    )
 
 
 @HYP

@@ -22,9 +22,26 @@ from impactsym import _kernels, solve_batch
 from impactsym import propagation as U
 from impactsym.testing import reference
 
-SCENE = {"m1": 1500.0, "m2": 1200.0, "I1": 2500.0, "I2": 2000.0, "v1x": 20.0, "v1y": 0.0,
-         "w1": 0.1, "v2x": 0.0, "v2y": 15.0, "w2": 0.0, "r1x": 2.0, "r1y": 0.3, "r2x": -0.5,
-         "r2y": -2.0, "gamma": 0.3, "e": 0.2, "mu": -0.4, "e_m": 0.8}
+SCENE = {
+    "m1": 1500.0,
+    "m2": 1200.0,
+    "I1": 2500.0,
+    "I2": 2000.0,
+    "v1x": 20.0,
+    "v1y": 0.0,
+    "w1": 0.1,
+    "v2x": 0.0,
+    "v2y": 15.0,
+    "w2": 0.0,
+    "r1x": 2.0,
+    "r1y": 0.3,
+    "r2x": -0.5,
+    "r2y": -2.0,
+    "gamma": 0.3,
+    "e": 0.2,
+    "mu": -0.4,
+    "e_m": 0.8,
+}
 
 
 def _close(got, want, names, outputs):
@@ -46,13 +63,13 @@ def _mp_gradient(func, point: dict, names, outputs):
                 # The reference rounds to 50 digits inside: a central step
                 # of 1e-15 relative (error ~1e-30) instead of mpmath's default.
                 step = mp.mpf("1e-15") * max(1, abs(point[x]))
-                grads[o][x] = mp.diff(lambda t, x=x, o=o: func({**point, x: t})[o],
-                                      mp.mpf(point[x]), h=step)
+                grads[o][x] = mp.diff(lambda t, x=x, o=o: func({**point, x: t})[o], mp.mpf(point[x]), h=step)
     return grads
 
 
-@pytest.mark.parametrize("model,critical", [("rigid", False), ("rigid", True),
-                                            ("particle", False), ("particle", True)])
+@pytest.mark.parametrize(
+    "model,critical", [("rigid", False), ("rigid", True), ("particle", False), ("particle", True)]
+)
 def test_forward_jacobian_matches_reference(model, critical):
     names = reference.RIGID_INPUTS if model == "rigid" else reference.PARTICLE_INPUTS
     point = {k: SCENE[k] for k in names}
@@ -64,8 +81,7 @@ def test_forward_jacobian_matches_reference(model, critical):
     ks = _kernels.JACOBIAN[model + ("_critical" if critical else "")]
     got = _kernels.run_one(ks, point, ks.outputs)
     assert got["status"] == 0
-    want = _mp_gradient(lambda p: reference.solve_reference(p, model, critical), point,
-                        names, outputs)
+    want = _mp_gradient(lambda p: reference.solve_reference(p, model, critical), point, names, outputs)
     _close(got, want, names, outputs)
 
 
@@ -90,18 +106,23 @@ def _mp_reconstruct(p: dict) -> dict:
 
     gn = rel(v1, v2, p["w1"], p["w2"])
     Gn = rel((p["V1x"], p["V1y"]), (p["V2x"], p["V2y"]), p["W1"], p["W2"])
-    return {"s1": s[0], "s2": s[1], "v1x": v1[0], "v2y": v2[1], "e": -Gn / gn,
-            "Pn": P[0] * n[0] + P[1] * n[1], "Pt": P[0] * t[0] + P[1] * t[1]}
+    return {
+        "s1": s[0],
+        "s2": s[1],
+        "v1x": v1[0],
+        "v2y": v2[1],
+        "e": -Gn / gn,
+        "Pn": P[0] * n[0] + P[1] * n[1],
+        "Pt": P[0] * t[0] + P[1] * t[1],
+    }
 
 
 def _reconstruct_point():
     """The finals of SCENE solved forward, with its headings."""
     fwd = solve_batch({k: np.array([v]) for k, v in SCENE.items()})
-    point = {k: SCENE[k] for k in ("m1", "m2", "I1", "I2", "w1", "w2", "r1x", "r1y",
-                                   "r2x", "r2y", "gamma")}
+    point = {k: SCENE[k] for k in ("m1", "m2", "I1", "I2", "w1", "w2", "r1x", "r1y", "r2x", "r2y", "gamma")}
     point.update({k: float(fwd[k][0]) for k in ("V1x", "V1y", "W1", "V2x", "V2y", "W2")})
-    point.update(theta1=math.atan2(SCENE["v1y"], SCENE["v1x"]),
-                 theta2=math.atan2(SCENE["v2y"], SCENE["v2x"]))
+    point.update(theta1=math.atan2(SCENE["v1y"], SCENE["v1x"]), theta2=math.atan2(SCENE["v2y"], SCENE["v2x"]))
     return point
 
 
@@ -176,10 +197,12 @@ def test_correlation_is_honoured_by_both_methods():
     point = _reconstruct_point()
     sd = {"V1x": 0.1, "V2x": 0.1}  # small: hardly a draw rejected, which would truncate
     src = _source(point, sd)
-    pos = U.propagate(U.Source(src.command, src.inputs, src.columns, (("V1x", "V2x", 0.9),)),
-                      draws=40_000, seed=3)
-    neg = U.propagate(U.Source(src.command, src.inputs, src.columns, (("V1x", "V2x", -0.9),)),
-                      draws=40_000, seed=3)
+    pos = U.propagate(
+        U.Source(src.command, src.inputs, src.columns, (("V1x", "V2x", 0.9),)), draws=40_000, seed=3
+    )
+    neg = U.propagate(
+        U.Source(src.command, src.inputs, src.columns, (("V1x", "V2x", -0.9),)), draws=40_000, seed=3
+    )
     for r in (pos, neg):
         assert r.accepted > 0.99 * r.n_draws
         drawn = np.corrcoef(r.draws["V1x"], r.draws["V2x"])[0, 1]
@@ -187,7 +210,8 @@ def test_correlation_is_honoured_by_both_methods():
         out = r.outputs["vehicles[0].speed"]
         assert abs(out["sd"] / out["sd_linear"] - 1) < 0.03
     assert pos.outputs["vehicles[0].speed"]["sd"] != pytest.approx(
-        neg.outputs["vehicles[0].speed"]["sd"], rel=0.1)
+        neg.outputs["vehicles[0].speed"]["sd"], rel=0.1
+    )
 
 
 def test_rejected_draws_are_counted_by_reason():
@@ -196,9 +220,15 @@ def test_rejected_draws_are_counted_by_reason():
     sd = {name: 3.0 for name in FINALS}
     result = U.propagate(_source(point, sd), draws=20_000, seed=5)
     assert result.accepted < result.n_draws
-    assert set(result.rejected) <= {"energy_created", "tensile_impulse", "mu_beyond_critical",
-                                    "e_out_of_range", "negative_speed", "not_approaching",
-                                    "singular"}
+    assert set(result.rejected) <= {
+        "energy_created",
+        "tensile_impulse",
+        "mu_beyond_critical",
+        "e_out_of_range",
+        "negative_speed",
+        "not_approaching",
+        "singular",
+    }
     assert result.rejected
     assert len(result.draws) == result.accepted
     assert (result.draws["restitution"].between(0, 1)).all()
@@ -213,8 +243,9 @@ def test_interval_covers_the_truth_at_the_nominal_rate():
     trials, hits = 300, 0
     for _ in range(trials):
         measured = {k: truth[k] + s * rng.standard_normal() for k, s in sd.items()}
-        result = U.propagate(_source({**truth, **measured}, sd, measured), draws=2000,
-                             seed=int(rng.integers(2**31)))
+        result = U.propagate(
+            _source({**truth, **measured}, sd, measured), draws=2000, seed=int(rng.integers(2**31))
+        )
         out = result.outputs["vehicles[0].speed"]
         hits += out["p5"] <= true_speed <= out["p95"]
     assert 0.845 <= hits / trials <= 0.945, hits / trials
@@ -226,8 +257,15 @@ def test_json_object_has_the_documented_keys():
     obj = result.to_json_dict()
     assert set(obj) >= {"draws", "accepted", "rejected", "inputs", "outputs"}
     assert obj["inputs"] == ["V1x", "V2y"]
-    expected = {"vehicles[0].speed", "vehicles[1].speed", "vehicles[0].delta_v_magnitude",
-                "energy_loss.total", "restitution", "impulse_ratio", "impulse.normal"}
+    expected = {
+        "vehicles[0].speed",
+        "vehicles[1].speed",
+        "vehicles[0].delta_v_magnitude",
+        "energy_loss.total",
+        "restitution",
+        "impulse_ratio",
+        "impulse.normal",
+    }
     assert expected <= set(obj["outputs"])
     for entry in obj["outputs"].values():
         assert set(entry) == {"nominal", "mean", "sd", "p5", "p50", "p95", "sd_linear", "budget"}
@@ -255,6 +293,8 @@ def test_jacobian_proof_catches_a_wrong_derivative():
     assert jacobian._agrees(knl, base, random.Random(1), points=1)
     blocks = list(knl.blocks)
     at = next(i for i, b in enumerate(blocks) if any(s.name == "d_TL__d_e" for s, _ in b.assigns))
-    blocks[at] = Block(tuple((s, x * 1.000001 if s.name == "d_TL__d_e" else x)
-                             for s, x in blocks[at].assigns), blocks[at].guard)
+    blocks[at] = Block(
+        tuple((s, x * 1.000001 if s.name == "d_TL__d_e" else x) for s, x in blocks[at].assigns),
+        blocks[at].guard,
+    )
     assert not jacobian._agrees(replace(knl, blocks=tuple(blocks)), base, random.Random(1), points=1)

@@ -51,9 +51,16 @@ def _vehicles():
         if row["test_vehicle"] == "8.1":  # "7 9 0 0 0 0" is a 2-point profile
             depths = [0.069, 0.091]
         mass = float(row["mass_kg"])
-        out.append({"mass": mass, "A": float(row["A_N_per_cm"]) * 100,
-                    "B": float(row["B_N_per_cm2"]) * 1e4, "width": float(row["L_cm"]) / 100,
-                    "depths": depths, "k": math.sqrt(float(row["yaw_inertia_kgm2"]) / mass)})
+        out.append(
+            {
+                "mass": mass,
+                "A": float(row["A_N_per_cm"]) * 100,
+                "B": float(row["B_N_per_cm2"]) * 1e4,
+                "width": float(row["L_cm"]) / 100,
+                "depths": depths,
+                "k": math.sqrt(float(row["yaw_inertia_kgm2"]) / mass),
+            }
+        )
     return out
 
 
@@ -63,15 +70,19 @@ def source():
     inputs = []
     for i, v in enumerate(vehicles):
         p = f"vehicles[{i}]"
-        inputs += [U.Input(f"{p}.mass", "uniform", (v["mass"] - 50, v["mass"] + 50)),
-                   U.Input(f"{p}.crush.width", "uniform", (v["width"] - 0.1524, v["width"] + 0.1524)),
-                   U.Input(f"{p}.crush.A", "uniform", (0.9 * v["A"], 1.1 * v["A"])),
-                   U.Input(f"{p}.crush.B", "uniform", (0.9 * v["B"], 1.1 * v["B"])),
-                   U.Input(f"{p}.crush.pdof", "uniform", (PDOF_DEG - 20, PDOF_DEG + 20)),
-                   U.Input(f"{p}.crush.moment_arm", "uniform", (-0.0762, 0.0762)),
-                   U.Input(f"{p}.crush.radius_of_gyration", "uniform", (v["k"] - 0.1, v["k"] + 0.1))]
-        inputs += [U.Input(f"{p}.crush.depths[{j}]", "uniform", (c - 0.0762, c + 0.0762))
-                   for j, c in enumerate(v["depths"])]
+        inputs += [
+            U.Input(f"{p}.mass", "uniform", (v["mass"] - 50, v["mass"] + 50)),
+            U.Input(f"{p}.crush.width", "uniform", (v["width"] - 0.1524, v["width"] + 0.1524)),
+            U.Input(f"{p}.crush.A", "uniform", (0.9 * v["A"], 1.1 * v["A"])),
+            U.Input(f"{p}.crush.B", "uniform", (0.9 * v["B"], 1.1 * v["B"])),
+            U.Input(f"{p}.crush.pdof", "uniform", (PDOF_DEG - 20, PDOF_DEG + 20)),
+            U.Input(f"{p}.crush.moment_arm", "uniform", (-0.0762, 0.0762)),
+            U.Input(f"{p}.crush.radius_of_gyration", "uniform", (v["k"] - 0.1, v["k"] + 0.1)),
+        ]
+        inputs += [
+            U.Input(f"{p}.crush.depths[{j}]", "uniform", (c - 0.0762, c + 0.0762))
+            for j, c in enumerate(v["depths"])
+        ]
 
     def columns(over):
         n = len(next(iter(over.values())))
@@ -79,8 +90,10 @@ def source():
         for i, v in enumerate(vehicles):
             p = f"vehicles[{i}]"
             cols[f"m{i + 1}"], cols[f"I{i + 1}"] = over[f"{p}.mass"], math.inf
-            table = {key: over[f"{p}.crush.{key}"] for key in ("width", "A", "B", "moment_arm",
-                                                               "radius_of_gyration")}
+            table = {
+                key: over[f"{p}.crush.{key}"]
+                for key in ("width", "A", "B", "moment_arm", "radius_of_gyration")
+            }
             table["alpha"] = np.deg2rad(over[f"{p}.crush.pdof"])
             for j in range(len(v["depths"])):
                 table[f"C{j + 1}"] = np.maximum(over[f"{p}.crush.depths[{j}]"], 0.0)
@@ -98,9 +111,10 @@ def half_width_95(result, path: str) -> float:
 
 def comparison(draws: int = 100_000, seed: int = 8):
     result = U.propagate(source(), draws=draws, seed=seed)
-    ours = {"energy": tuple(half_width_95(result, f"vehicles[{i}].crush_energy") for i in (0, 1)),
-            "delta_v": tuple(half_width_95(result, f"vehicles[{i}].delta_v_magnitude")
-                             for i in (0, 1))}
+    ours = {
+        "energy": tuple(half_width_95(result, f"vehicles[{i}].crush_energy") for i in (0, 1)),
+        "delta_v": tuple(half_width_95(result, f"vehicles[{i}].delta_v_magnitude") for i in (0, 1)),
+    }
     return result, ours
 
 

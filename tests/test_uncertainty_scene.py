@@ -36,8 +36,13 @@ def _uncertain(name: str, edit) -> dict:
 
 def _cli(*args, path: Path):
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    return subprocess.run([sys.executable, "-m", "impactsym", *args, str(path)], env=env,
-                          capture_output=True, text=True, cwd=ROOT)
+    return subprocess.run(
+        [sys.executable, "-m", "impactsym", *args, str(path)],
+        env=env,
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
 
 
 def _forward(d):
@@ -57,9 +62,14 @@ def _crash3(d):
 
 # CRASH3's restitution is an option, not a result; the impulse-momentum
 # comparison fields come from a separate forward solve (docs/uncertainty.md).
-NOT_PROPAGATED = {"crash3": {"restitution", "options.restitution"} | {
-    f"vehicles[{i}].{key}" for i in (0, 1)
-    for key in ("pdof_implied", "delta_v_magnitude_impulse_momentum")}}
+NOT_PROPAGATED = {
+    "crash3": {"restitution", "options.restitution"}
+    | {
+        f"vehicles[{i}].{key}"
+        for i in (0, 1)
+        for key in ("pdof_implied", "delta_v_magnitude_impulse_momentum")
+    }
+}
 
 CASES = [
     ("solve", "two_car_us.json", _forward),
@@ -88,8 +98,9 @@ def test_every_numeric_output_has_an_entry(tmp_path, command, name, edit):
 def test_api_reconstruction_speeds_and_plot(tmp_path):
     from impactsym.uncertainty_plot import save_uncertainty_plot
 
-    u = impactsym.uncertainty(EXAMPLES / "reconstruct_intersection_uncertain.json",
-                              command="reconstruct", draws=20_000, seed=3)
+    u = impactsym.uncertainty(
+        EXAMPLES / "reconstruct_intersection_uncertain.json", command="reconstruct", draws=20_000, seed=3
+    )
     assert "vehicles[0].final_velocity.speed" in u.inputs
     nominal = impactsym.reconstruct(EXAMPLES / "reconstruct_intersection_uncertain.json")
     speed = u.outputs["vehicles[0].speed"]

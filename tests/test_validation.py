@@ -20,20 +20,30 @@ REPO_ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOK = REPO_ROOT / "notebooks" / "06_models.ipynb"
 TOLERANCE = {"|dv| err %": 8.0, "dvx err %": 8.0, "dvy err %": 20.0, "dyaw err %": 30.0}
 MEDIAN_TOLERANCE = {"|dv| err %": 3.0, "dyaw err %": 3.0}
-FUSION_TESTS = {"CF10017", "CF10023", "CF11016", "CF10020", "CF10028", "CF11002", "CF11004",
-                "CF11012", "CF11013"}
+FUSION_TESTS = {
+    "CF10017",
+    "CF10023",
+    "CF11016",
+    "CF10020",
+    "CF10028",
+    "CF11002",
+    "CF11004",
+    "CF11012",
+    "CF11013",
+}
 MARKER = "VALIDATION-JSON:"
 
 
 @pytest.fixture(scope="module")
 def fusion_table():
     nb = nbformat.read(NOTEBOOK, as_version=4)
-    nb.cells.insert(0, nbformat.v4.new_code_cell(
-        f"import sys as _sys\nassert _sys.prefix == {sys.prefix!r}\ndel _sys"))
-    nb.cells.append(nbformat.v4.new_code_cell(
-        f"print({MARKER!r} + fusion_table.to_json(orient='records'))"))
-    nbclient.NotebookClient(nb, timeout=300, kernel_name="python3",
-                            resources={"metadata": {"path": str(REPO_ROOT)}}).execute()
+    nb.cells.insert(
+        0, nbformat.v4.new_code_cell(f"import sys as _sys\nassert _sys.prefix == {sys.prefix!r}\ndel _sys")
+    )
+    nb.cells.append(nbformat.v4.new_code_cell(f"print({MARKER!r} + fusion_table.to_json(orient='records'))"))
+    nbclient.NotebookClient(
+        nb, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(REPO_ROOT)}}
+    ).execute()
     text = "".join(o.get("text", "") for o in nb.cells[-1].outputs)
     return json.loads(text.split(MARKER, 1)[1])
 

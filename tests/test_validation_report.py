@@ -60,8 +60,11 @@ def datasets():
 
 def comparison(datasets, key):
     dataset, model, quantity, reference = key
-    found = [c for c in datasets[dataset].comparisons
-             if (c.model, c.quantity, c.reference) == (model, quantity, reference)]
+    found = [
+        c
+        for c in datasets[dataset].comparisons
+        if (c.model, c.quantity, c.reference) == (model, quantity, reference)
+    ]
     assert len(found) == 1, key
     return found[0]
 
@@ -73,14 +76,22 @@ def comparison(datasets, key):
 # by 33-207 % in the oblique and side tests: Woolley's side inputs differ from the
 # category defaults Neades published (even uncorrected, test 1 gives 67 000 ft·lb
 # against his 48 392), and the capped correction doubles the side energies.
-MISSED = {("ricsac", "CRASH3 (published profiles)", "energy loss", "Woolley's CRASH3 (1985)"):
-          "first run: median 32.5 %, worst 207 % (bound 20 %): Woolley's 1985 side-impact "
-          "inputs differ from the published defaults"}
+MISSED = {
+    (
+        "ricsac",
+        "CRASH3 (published profiles)",
+        "energy loss",
+        "Woolley's CRASH3 (1985)",
+    ): "first run: median 32.5 %, worst 207 % (bound 20 %): Woolley's 1985 side-impact "
+    "inputs differ from the published defaults"
+}
 
 
 def _cases():
-    return [pytest.param(key, marks=pytest.mark.xfail(strict=True, reason=MISSED[key]))
-            if key in MISSED else key for key in sorted(BOUNDS)]
+    return [
+        pytest.param(key, marks=pytest.mark.xfail(strict=True, reason=MISSED[key])) if key in MISSED else key
+        for key in sorted(BOUNDS)
+    ]
 
 
 @pytest.mark.parametrize("key", _cases(), ids=lambda k: " | ".join(k))
@@ -96,13 +107,14 @@ def test_errors_within_the_bounds_chosen_before_looking(datasets, key):
 def test_every_row_is_run(datasets):
     ricsac = datasets["ricsac"]
     assert len(ricsac.tables["crash3 published"]) == 24
-    assert len(ricsac.tables["energy"]) == 11               # test 2 has no energies
-    assert len(ricsac.tables["pim"]) == 11                  # Vossou has no test 2
+    assert len(ricsac.tables["energy"]) == 11  # test 2 has no energies
+    assert len(ricsac.tables["pim"]) == 11  # Vossou has no test 2
     assert len(datasets["iihs"].tables["barrier"]) == 41
     assert len(datasets["nhtsa"].tables["nhtsa"]) == 6
-    measured = comparison(datasets, ("ricsac", "CRASH3 (Neades' adjustments)", "delta-V",
-                                     "measured, Brach & Smith 2002"))
-    assert len(measured.rows) == 22                         # 11 tests with accelerometers
+    measured = comparison(
+        datasets, ("ricsac", "CRASH3 (Neades' adjustments)", "delta-V", "measured, Brach & Smith 2002")
+    )
+    assert len(measured.rows) == 22  # 11 tests with accelerometers
 
 
 def test_side_impacts_beyond_45_degrees_are_capped(datasets):
@@ -119,8 +131,9 @@ def test_crush_energy_above_the_initial_kinetic_energy_is_flagged(datasets):
     """Physically impossible results are flagged, never silently returned."""
     energy = datasets["ricsac"].tables["energy"]
     flagged = {r["test"] for r in energy if r["impossible"]}
-    assert flagged == {r["test"] for r in energy
-                       if max(r["published"], r["published, woolley"], r["neades"]) > r["initial"]}
+    assert flagged == {
+        r["test"] for r in energy if max(r["published"], r["published, woolley"], r["neades"]) > r["initial"]
+    }
     notes = [n for n in datasets["ricsac"].notes if n.startswith("PHYSICALLY IMPOSSIBLE")]
     assert len(notes) == len(flagged)
 
@@ -135,15 +148,19 @@ def test_cg_and_effective_mass_delta_v(datasets):
 def test_the_report_says_the_separation_velocities_are_inconsistent(datasets):
     momentum = datasets["ricsac"].tables["momentum"]
     worst = max(abs(r["x_pct"]) for r in momentum)
-    assert worst > 10.0                                     # README: up to ~22 % in x
+    assert worst > 10.0  # README: up to ~22 % in x
     assert any("do not conserve momentum" in note for note in datasets["ricsac"].notes)
 
 
 def test_statistics_are_of_the_rows():
     c = validation.Comparison("d", "m", "q", "r", (("a", 11.0, 10.0), ("b", 8.0, 10.0), ("c", 10.5, 10.0)))
     assert c.errors == pytest.approx([10.0, -20.0, 5.0])
-    assert c.stats() == {"n": 3, "median": pytest.approx(10.0), "worst": pytest.approx(20.0),
-                         "bias": pytest.approx(5.0)}
+    assert c.stats() == {
+        "n": 3,
+        "median": pytest.approx(10.0),
+        "worst": pytest.approx(20.0),
+        "bias": pytest.approx(5.0),
+    }
     assert math.isnan(validation.stats([])["median"])
 
 

@@ -54,8 +54,15 @@ def test_every_runtime_driver_is_listed_once():
     drivers = [(ks.name, p, n) for ks, p, n in _kernels.batch_drivers()]
     assert len(drivers) == len(set(drivers))
     names = {name for name, _, _ in drivers}
-    assert {"rigid", "particle_critical", "rigid_inverse", "reconstruct", "crash3_delta_v",
-            "delta_v_from_energy", "kinetic_energy"} <= names
+    assert {
+        "rigid",
+        "particle_critical",
+        "rigid_inverse",
+        "reconstruct",
+        "crash3_delta_v",
+        "delta_v_from_energy",
+        "kinetic_energy",
+    } <= names
     assert not any(name.endswith("_jacobian") for name in names)
 
 

@@ -37,7 +37,26 @@ from mpmath import mp
 DPS = 50
 """Working precision of the reference, in decimal digits."""
 
-RIGID_INPUTS = ["m1", "m2", "I1", "I2", "v1x", "v1y", "w1", "v2x", "v2y", "w2", "r1x", "r1y", "r2x", "r2y", "gamma", "e", "mu", "e_m"]
+RIGID_INPUTS = [
+    "m1",
+    "m2",
+    "I1",
+    "I2",
+    "v1x",
+    "v1y",
+    "w1",
+    "v2x",
+    "v2y",
+    "w2",
+    "r1x",
+    "r1y",
+    "r2x",
+    "r2y",
+    "gamma",
+    "e",
+    "mu",
+    "e_m",
+]
 PARTICLE_INPUTS = ["m1", "m2", "v1x", "v1y", "v2x", "v2y", "gamma", "e", "mu"]
 OUTPUTS = ["V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M", "mu", "mu_c", "TL", "TLn", "TLt", "TLm"]
 VELOCITY_KEYS = ("V1x", "V1y", "V2x", "V2y")
@@ -48,6 +67,7 @@ _TINY = "1e-300"  # floor of every natural scale, so a scale is never 0
 
 
 # --------------------------------------------------------------------------- inputs
+
 
 def _mp_scene(row: dict, model: str) -> dict:
     """Convert a scene row to exact ``mpf`` values (rigid fields filled in for particles).
@@ -96,6 +116,7 @@ def contact_velocity(vx, vy, w, rx, ry):
 
 # --------------------------------------------------------------------------- system
 
+
 def _rigid_system(s: dict, critical: bool):
     """Matrix A and right-hand side b of the 9x9 system in (V1x V1y W1 V2x V2y W2 Px Py M).
 
@@ -114,21 +135,29 @@ def _rigid_system(s: dict, critical: bool):
     z = mp.zero
     # columns:  V1x V1y W1  V2x V2y W2  Px       Py        M
     A = [
-        [1, 0, 0, 0, 0, 0, -k1, 0, 0],                          # V1x - k1 Px = v1x
-        [0, 1, 0, 0, 0, 0, 0, -k1, 0],                          # V1y - k1 Py = v1y
-        [0, 0, 1, 0, 0, 0, j1 * r1y, -j1 * r1x, -j1],           # W1 - j1 (r1xP + M) = w1
-        [0, 0, 0, 1, 0, 0, k2, 0, 0],                           # V2x + k2 Px = v2x
-        [0, 0, 0, 0, 1, 0, 0, k2, 0],                           # V2y + k2 Py = v2y
-        [0, 0, 0, 0, 0, 1, -j2 * r2y, j2 * r2x, j2],            # W2 + j2 (r2xP + M) = w2
-        [-nx, -ny, -_cross(r1x, r1y, nx, ny),                   # n.(U2 - U1) = -e gn
-         nx, ny, _cross(r2x, r2y, nx, ny), 0, 0, 0],
-        None,                                                   # ratio / sticking
+        [1, 0, 0, 0, 0, 0, -k1, 0, 0],  # V1x - k1 Px = v1x
+        [0, 1, 0, 0, 0, 0, 0, -k1, 0],  # V1y - k1 Py = v1y
+        [0, 0, 1, 0, 0, 0, j1 * r1y, -j1 * r1x, -j1],  # W1 - j1 (r1xP + M) = w1
+        [0, 0, 0, 1, 0, 0, k2, 0, 0],  # V2x + k2 Px = v2x
+        [0, 0, 0, 0, 1, 0, 0, k2, 0],  # V2y + k2 Py = v2y
+        [0, 0, 0, 0, 0, 1, -j2 * r2y, j2 * r2x, j2],  # W2 + j2 (r2xP + M) = w2
+        [
+            -nx,
+            -ny,
+            -_cross(r1x, r1y, nx, ny),  # n.(U2 - U1) = -e gn
+            nx,
+            ny,
+            _cross(r2x, r2y, nx, ny),
+            0,
+            0,
+            0,
+        ],
+        None,  # ratio / sticking
         [0, 0, -(1 - em), 0, 0, (1 - em), 0, 0, -em * (j1 + j2)],  # moment restitution
     ]
     b = [s["v1x"], s["v1y"], s["w1"], s["v2x"], s["v2y"], s["w2"], -e * gn, z, z]
     if critical:  # t.(U2 - U1) = 0
-        A[7] = [-tx, -ty, -_cross(r1x, r1y, tx, ty),
-                tx, ty, _cross(r2x, r2y, tx, ty), 0, 0, 0]
+        A[7] = [-tx, -ty, -_cross(r1x, r1y, tx, ty), tx, ty, _cross(r2x, r2y, tx, ty), 0, 0, 0]
     else:  # P.t - mu P.n = 0
         mu = s["mu"]
         A[7] = [0, 0, 0, 0, 0, 0, tx - mu * nx, ty - mu * ny, 0]
@@ -171,6 +200,7 @@ def _solve_raw(s: dict, model: str, critical: bool) -> dict:
 
 # --------------------------------------------------------------------------- energy
 
+
 def kinetic_energy(m, I, vx, vy, w):
     """Kinetic energy 0.5 m |v|^2 + 0.5 I w^2 of one body (J or ft lb); a fixed body gives 0.
 
@@ -190,18 +220,21 @@ def initial_kinetic_energy(row: dict, model: str = "rigid"):
         s = _mp_scene(row, model)
         I1 = s.get("I1", mp.inf)
         I2 = s.get("I2", mp.inf)
-        return (kinetic_energy(s["m1"], I1, s["v1x"], s["v1y"], s["w1"])
-                + kinetic_energy(s["m2"], I2, s["v2x"], s["v2y"], s["w2"]))
+        return kinetic_energy(s["m1"], I1, s["v1x"], s["v1y"], s["w1"]) + kinetic_energy(
+            s["m2"], I2, s["v2x"], s["v2y"], s["w2"]
+        )
 
 
 def _energies(s: dict, x: dict, model: str) -> dict:
     """TL as a kinetic-energy difference, and the partition TLn, TLt, TLm (work of P and M)."""
     I1 = s["I1"] if model == "rigid" else mp.inf  # particles: no yaw energy
     I2 = s["I2"] if model == "rigid" else mp.inf
-    before = (kinetic_energy(s["m1"], I1, s["v1x"], s["v1y"], s["w1"])
-              + kinetic_energy(s["m2"], I2, s["v2x"], s["v2y"], s["w2"]))
-    after = (kinetic_energy(s["m1"], I1, x["V1x"], x["V1y"], x["W1"])
-             + kinetic_energy(s["m2"], I2, x["V2x"], x["V2y"], x["W2"]))
+    before = kinetic_energy(s["m1"], I1, s["v1x"], s["v1y"], s["w1"]) + kinetic_energy(
+        s["m2"], I2, s["v2x"], s["v2y"], s["w2"]
+    )
+    after = kinetic_energy(s["m1"], I1, x["V1x"], x["V1y"], x["W1"]) + kinetic_energy(
+        s["m2"], I2, x["V2x"], x["V2y"], x["W2"]
+    )
     (nx, ny), (tx, ty) = _frame(s["gamma"])
     u1 = contact_velocity(s["v1x"], s["v1y"], s["w1"], s["r1x"], s["r1y"])
     u2 = contact_velocity(s["v2x"], s["v2y"], s["w2"], s["r2x"], s["r2y"])
@@ -214,11 +247,22 @@ def _energies(s: dict, x: dict, model: str) -> dict:
     Pn = nx * x["Px"] + ny * x["Py"]
     Pt = tx * x["Px"] + ty * x["Py"]
     TLm = x["M"] * ((s["w2"] - s["w1"]) + (x["W2"] - x["W1"])) / 2
-    return dict(Pn=Pn, Pt=Pt, TL=before - after, TLn=Pn * (gn + Gn) / 2,
-                TLt=Pt * (gt + Gt) / 2, TLm=TLm, gn=gn, gt=gt, Gn=Gn, Gt=Gt)
+    return dict(
+        Pn=Pn,
+        Pt=Pt,
+        TL=before - after,
+        TLn=Pn * (gn + Gn) / 2,
+        TLt=Pt * (gt + Gt) / 2,
+        TLm=TLm,
+        gn=gn,
+        gt=gt,
+        Gn=Gn,
+        Gt=Gt,
+    )
 
 
 # --------------------------------------------------------------------------- public
+
 
 def _ratio(Pt, Pn):
     """Pt/Pn, NaN when Pn = 0 (no normal impulse: not an approaching scene)."""
@@ -336,8 +380,7 @@ def relative_errors(got: dict, ref: dict, scales: dict) -> dict:
 
 def row_of(columns: dict, i: int) -> dict:
     """Row ``i`` of a columns dict as Python floats (a string column, e.g. "critical", is kept)."""
-    return {key: (col if isinstance(col, str) else float(col[i]))
-            for key, col in columns.items()}
+    return {key: (col if isinstance(col, str) else float(col[i])) for key, col in columns.items()}
 
 
 def n_rows(columns: dict) -> int:

@@ -77,15 +77,15 @@ def _closing(c, model):
         u1 = reference_contact(c, 1)
         u2 = reference_contact(c, 2)
     gn = nx * (u2[0] - u1[0]) + ny * (u2[1] - u1[1])
-    speed = np.max([np.hypot(*u1), np.hypot(*u2), np.hypot(c["v1x"], c["v1y"]),
-                    np.hypot(c["v2x"], c["v2y"])], axis=0)
+    speed = np.max(
+        [np.hypot(*u1), np.hypot(*u2), np.hypot(c["v1x"], c["v1y"]), np.hypot(c["v2x"], c["v2y"])], axis=0
+    )
     return gn, speed
 
 
 def reference_contact(c, i):
     """Contact-point velocity u_i = v_i + w_i (-r_iy, r_ix) of vehicle i, float64 arrays."""
-    return (c[f"v{i}x"] - c[f"w{i}"] * c[f"r{i}y"],
-            c[f"v{i}y"] + c[f"w{i}"] * c[f"r{i}x"])
+    return (c[f"v{i}x"] - c[f"w{i}"] * c[f"r{i}y"], c[f"v{i}y"] + c[f"w{i}"] * c[f"r{i}x"])
 
 
 def _approaching(c, model):
@@ -116,8 +116,11 @@ def _accept(row, refs, speed):
         change = 0.0
         for i in (1, 2):
             if not np.isinf(row[f"m{i}"]):
-                change = max(change, abs(float(ref[f"V{i}x"]) - row[f"v{i}x"]),
-                             abs(float(ref[f"V{i}y"]) - row[f"v{i}y"]))
+                change = max(
+                    change,
+                    abs(float(ref[f"V{i}x"]) - row[f"v{i}x"]),
+                    abs(float(ref[f"V{i}y"]) - row[f"v{i}y"]),
+                )
             lever = np.hypot(row.get(f"r{i}x", 0.0), row.get(f"r{i}y", 0.0))
             change = max(change, abs(float(ref[f"W{i}"]) - row.get(f"w{i}", 0.0)) * lever)
         if not change <= MAX_VELOCITY_CHANGE * speed:
@@ -178,8 +181,7 @@ def random_realistic(n: int, seed: int, model: str = "rigid", barrier: bool = Fa
     return {key: np.ascontiguousarray(c[key], dtype=np.float64) for key in names}
 
 
-TABLE2_TL = np.array([96000.0, 192000.0, 96000.0, -192000.0,
-                      0.0, 96000.0, 0.0, -288000.0])
+TABLE2_TL = np.array([96000.0, 192000.0, 96000.0, -192000.0, 0.0, 96000.0, 0.0, -288000.0])
 """Seed Table 2 energy loss T_L (ft lb) for the rows of ``table2_scenes``."""
 
 
@@ -200,8 +202,17 @@ def table2_scenes():
     a1 = 50.0 * np.sqrt(0.5)
     a2 = -30.0 * np.sqrt(0.5)
     ones = np.ones(8)
-    columns = dict(m1=100.0 * ones, m2=150.0 * ones, v1x=a1 * ones, v1y=a1 * ones,
-                   v2x=a2 * ones, v2y=a2 * ones, gamma=0.0 * ones, e=e, mu=mu)
+    columns = dict(
+        m1=100.0 * ones,
+        m2=150.0 * ones,
+        v1x=a1 * ones,
+        v1y=a1 * ones,
+        v2x=a2 * ones,
+        v2y=a2 * ones,
+        gamma=0.0 * ones,
+        e=e,
+        mu=mu,
+    )
     return columns, TABLE2_TL.copy()
 
 
