@@ -150,9 +150,10 @@ def source_hash() -> str:
 
 
 def package_version() -> str:
-    """impactsym's version, from pyproject.toml next to derive/."""
-    text = (DERIVE_DIR.parent / "pyproject.toml").read_text()
-    return re.search(r'^version = "([^"]+)"', text, re.MULTILINE).group(1)
+    """impactsym's version, read (not imported) from impactsym/_version.py, the
+    one place it is written."""
+    text = (DERIVE_DIR.parent / "impactsym" / "_version.py").read_text()
+    return re.search(r'^__version__ = "([^"]+)"', text, re.MULTILINE).group(1)
 
 
 def header(model_file: str, digest: str) -> str:

@@ -13,6 +13,7 @@ the glob in index.md without an edit here.
 import json
 import re
 import runpy
+import shutil
 import sys
 from pathlib import Path
 
@@ -78,6 +79,23 @@ def _escape_bars(line: str) -> str:
 
 def _plain_docstring(app, what, name, obj, options, lines):
     lines[:] = [_escape_bars(line) for line in lines]
+
+
+def _copy_notebooks() -> None:
+    """The notebooks live in notebooks/ (tests execute them there); the site renders
+    copies in docs/notebooks/ (git-ignored), made afresh at every build. A copy,
+    not a link: a link made packaging tools ship the notebooks under docs/ only."""
+    here = Path(__file__).resolve().parent
+    target = here / "notebooks"
+    if target.is_symlink():
+        target.unlink()
+    shutil.rmtree(target, ignore_errors=True)
+    target.mkdir()
+    for notebook in sorted((here.parent / "notebooks").glob("*.ipynb")):
+        shutil.copy2(notebook, target / notebook.name)
+
+
+_copy_notebooks()
 
 
 def _python_notebook(app, docname, source):
