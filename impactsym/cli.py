@@ -595,6 +595,8 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_TERMINATED
     except (UsageError, SceneError) as exc:
         return _fail(str(exc))
+    except ImportError as exc:  # an optional dependency the scene or option needs
+        return _fail(str(exc))
     except OSError as exc:
         return _fail(f"{exc.filename}: {exc.strerror}" if exc.filename else str(exc))
     except SystemExit as exc:
@@ -620,10 +622,15 @@ def _terminate_as_exit():
         yield
         return
     previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    # SIGINT as KeyboardInterrupt whatever the disposition inherited from the
+    # parent (a script's background job inherits it ignored): Ctrl-C or
+    # `kill -INT` always stops a command cleanly, spill files removed.
+    previous_int = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         yield
     finally:
         signal.signal(signal.SIGTERM, previous)
+        signal.signal(signal.SIGINT, previous_int)
 
 
 def _reader_gone() -> int:

@@ -26,6 +26,8 @@ import functools
 import math
 from dataclasses import dataclass
 
+from ._util import require
+
 __all__ = [
     "DIMENSIONS",
     "GRAVITY",
@@ -107,9 +109,9 @@ SCENE_UNITS = {
 
 @functools.cache
 def registry():
-    """The process's one pint UnitRegistry, built on first use."""
-    import pint
-
+    """The process's one pint UnitRegistry, built on first use (ImportError
+    with the extra to install when pint is missing)."""
+    pint = require("pint", extra="units", what="a unit string in a scene")
     return pint.UnitRegistry()
 
 
