@@ -642,3 +642,16 @@ def test_alternative_forms_give_the_plain_inverse_and_reconstruction_columns(pai
             else:
                 group = [v for k, v in a.items() if k[:1] == name[:1] and k != "gamma"]
                 assert abs(a[name] - b[name]) <= 1e-12 * _scale(group), name
+
+
+def test_a_unit_string_without_pint_is_one_line_naming_the_extra(tmp_path):
+    """pint is the optional `units` extra: without it a scene with a unit string
+    is refused in one line that says what to install (exit 2), never a traceback."""
+    script = (
+        "import sys; sys.modules['pint'] = None\n"
+        "from impactsym.cli import main\n"
+        "sys.exit(main(['reconstruct', 'examples/reconstruct_intersection_us_casefile.json']))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True)
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1 and "pip install 'impactsym[units]'" in done.stderr
