@@ -473,15 +473,16 @@ def test_the_limits_follow_what_the_machine_has(monkeypatch, tmp_path):
 def test_an_interrupted_sweep_leaves_no_spill_file_and_no_traceback(tmp_path, signal_name, code, said):
     temp = tmp_path / "tmp"
     temp.mkdir()
-    # 1e6 rows in chunks of 500: about 20 s of work, interrupted once it spills.
+    # 4e6 rows in chunks of 500: far more work than the half second before the signal,
+    # even with every driver cached (1e6 rows could finish first on a warm machine).
     process = subprocess.Popen(
         _cli(
             "sweep",
             US_SCENE,
             "--vary",
-            "e=0:1:1000",
+            "e=0:1:2000",
             "--vary",
-            "mu=0:0.5:1000",
+            "mu=0:0.5:2000",
             "--chunk-size",
             "500",
             "--no-progress",
