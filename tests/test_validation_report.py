@@ -92,37 +92,59 @@ def comparison(datasets, key):
 
 # Bounds chosen before looking that the first run MISSED: kept as chosen, run as
 # strict xfails (the test fails if the miss ever disappears), and reported in
-# docs/validation.md. Our crush energies reproduce Woolley's 1985 CRASH3 energies
-# within 1-4 % in the five tests with small PDOFs (3, 4, 5, 11, 12) but exceed them
-# by 33-207 % in the oblique and side tests: Woolley's side inputs differ from the
-# category defaults Neades published (even uncorrected, test 1 gives 67 000 ft·lb
-# against his 48 392), and the capped correction doubles the side energies.
+# docs/validation.md. Keyed by (comparison, "median" | "worst").
+# 1. Our crush energies reproduce Woolley's 1985 CRASH3 energies within 1-4 % in
+# the five tests with small PDOFs (3, 4, 5, 11, 12) but exceed them by 33-207 % in
+# the oblique and side tests: Woolley's side inputs differ from the category
+# defaults Neades published (even uncorrected, test 1 gives 67 000 ft·lb against
+# his 48 392), and the capped correction doubles the side energies.
+# 2. IIHS V2V yaw-rate change (first run; the median bounds of all 18 vehicles and
+# of the 12 sideswipe vehicles held: 20.6 % and 19.2 %): the two 15° oblique tests
+# CF10012 and CF10013 come out with the yaw of the two cars swapped (e.g. CF10013:
+# 5.9 and 235 deg/s against the measured 205 and 73) under the geometry decided
+# before the run (b's heading 195°, converging, Γ in a's frame). The opposite sense
+# (165°) gives a median 25 % on those four vehicles (report table "oblique
+# readings"), so the oblique geometry was most likely the other one; it is NOT
+# switched after looking: the decided reading stays the one reported and tested.
 MISSED = {
     (
-        "ricsac",
-        "CRASH3 (published profiles)",
-        "energy loss",
-        "Woolley's CRASH3 (1985)",
+        ("ricsac", "CRASH3 (published profiles)", "energy loss", "Woolley's CRASH3 (1985)"),
+        "median",
     ): "first run: median 32.5 %, worst 207 % (bound 20 %): Woolley's 1985 side-impact "
-    "inputs differ from the published defaults"
+    "inputs differ from the published defaults",
+    (
+        ("iihs_v2v", V2V, "yaw-rate change", "measured"),
+        "worst",
+    ): "first run: worst 220 % (bound 75 %), CF10013b: the oblique tests' yaws come out swapped "
+    "between the cars under the a-priori oblique geometry (195 deg, converging)",
+    (
+        ("iihs_v2v", V2V, "yaw-rate change", "measured, non-sideswipe"),
+        "median",
+    ): "first run: median 71.8 % (bound 40 %): the two oblique tests (4 of the 6 vehicles), as above",
 }
 
 
 def _cases():
-    return [
-        pytest.param(key, marks=pytest.mark.xfail(strict=True, reason=MISSED[key])) if key in MISSED else key
-        for key in sorted(BOUNDS)
-    ]
+    cases = []
+    for key in sorted(BOUNDS):
+        for which, bound in zip(("median", "worst"), BOUNDS[key]):
+            if bound is None:
+                continue
+            case = (key, which)
+            reason = MISSED.get(case)
+            cases.append(
+                pytest.param(case, marks=pytest.mark.xfail(strict=True, reason=reason)) if reason else case
+            )
+    return cases
 
 
-@pytest.mark.parametrize("key", _cases(), ids=lambda k: " | ".join(k))
-def test_errors_within_the_bounds_chosen_before_looking(datasets, key):
+@pytest.mark.parametrize("case", _cases(), ids=lambda c: " | ".join(c[0]) + " | " + c[1])
+def test_errors_within_the_bounds_chosen_before_looking(datasets, case):
+    key, which = case
     stats = comparison(datasets, key).stats()
-    median, worst = BOUNDS[key]
+    bound = BOUNDS[key][which == "worst"]
     assert stats["n"] > 0
-    assert stats["median"] <= median, stats
-    if worst is not None:
-        assert stats["worst"] <= worst, stats
+    assert stats[which] <= bound, stats
 
 
 def test_every_row_is_run(datasets):
