@@ -15,6 +15,11 @@ with programmatic scenes:
 - **IIHS small-overlap barrier tests** (41, Brach et al. SAE 2014-01-0469): the
   rigid model with Brach's fitted parameters against the measured delta-V and
   yaw-rate change;
+- **IIHS small-overlap vehicle-to-vehicle tests** (9 tests, 18 vehicles, same
+  paper): the rigid model with Brach's fitted e, μ, φ, Γ, the CG-to-impact
+  distance APPROXIMATED from his barrier fits of the same car model and the
+  masses ASSUMED (the Fusion's), against the measured |delta-V| and yaw-rate
+  change, with the sensitivity to d, the mass ratio and k;
 - **NHTSA 4364, 4438, 4474** (car-to-SUV, Rose et al. SAE 2006-01-0908): the
   rigid model with the published inputs against the published PIM energies,
   delta-V and yaw rates, and the measured delta-V.
@@ -1262,10 +1267,17 @@ def plot(datasets: list[Dataset], directory: Path | str) -> list[Path]:
             comps = [_find(ds, e[0], e[1], e[2] if len(e) > 2 else reference) for e in series]
             mixed_q = len({c.quantity for c in comps}) > 1
             mixed_r = len({c.reference for c in comps}) > 1
+            # One model against several references: the model in the title, the
+            # references in the legend.
+            by_reference = mixed_r and not mixed_q and len({c.model for c in comps}) == 1
+            if by_reference:
+                title = f"{title}\n{comps[0].model}"
             for comp in comps:
                 xs, ys = [r for _, _, r in comp.rows], [m for _, m, _ in comp.rows]
                 label = (
-                    comp.model
+                    comp.reference
+                    if by_reference
+                    else comp.model
                     + (f", {comp.quantity}" if mixed_q else "")
                     + (f" vs {comp.reference}" if mixed_r else "")
                 )
