@@ -250,3 +250,16 @@ def test_v2v_states_its_assumptions_and_sensitivity(datasets):
         if row["case"].startswith("m_b x"):
             assert row["ratio_a_to_b"] == pytest.approx(float(row["case"].split()[-1]), rel=1e-9)
     assert any("Sensitivity" in note for note in ds.notes)
+
+
+def test_v2v_head_on_geometry_is_point_symmetric():
+    """Truth from symmetry, not from the solver: two identical cars (the same row
+    as a and b) head-on, each struck on its left front, are the same crash seen
+    from either car, so their |delta-V| and yaw-rate changes must be equal and the
+    yaw counter-clockwise (toward the struck side) for both."""
+    a, _ = validation._v2v_tests()["CF11009"]
+    result = validation._v2v_solve((a, a))
+    one, two = result.vehicles
+    assert one.delta_v_magnitude == pytest.approx(two.delta_v_magnitude, rel=1e-9)
+    assert one.yaw_rate == pytest.approx(two.yaw_rate, rel=1e-9)
+    assert one.yaw_rate > 0.0 and result.flags == 0
