@@ -1,5 +1,5 @@
 """``python -m impactsym``: the command line of :mod:`impactsym.cli`."""
 
-from .cli import main
+from .cli import run
 
-raise SystemExit(main())
+run()

@@ -157,17 +157,21 @@ def _flag_restitution(e, status: np.ndarray, flags: np.ndarray) -> None:
     each other after the impact, e > 1 creates normal energy. The kernel
     solves them (its equations hold for any e) and the scene path warns; a
     batch row has no warnings, so it carries the flag. NaN e is status 1."""
-    outside = (np.asarray(e) < 0.0) | (np.asarray(e) > 1.0)
-    if np.any(outside):
-        flags |= np.where(outside & (status == 0), FLAG_E_OUT_OF_RANGE, 0).astype(flags.dtype)
+    e = np.asarray(e).ravel()
+    # Two reductions without temporaries first: almost every batch has no such
+    # row, and the mask (three passes over the rows) is built only when one is
+    # there. fmin/fmax skip NaN (np.min would return NaN and hide the others).
+    if not (np.fmin.reduce(e, initial=0.0) < 0.0 or np.fmax.reduce(e, initial=1.0) > 1.0):
+        return
+    outside = (e < 0.0) | (e > 1.0)
+    flags |= np.where(outside & (status == 0), FLAG_E_OUT_OF_RANGE, 0).astype(flags.dtype)
 
 
 def _collect(ks, outs, status, flags, outputs, n) -> dict:
     """The requested outputs of a kernel run: computed, constant (e_m = 1:
     M = 0) or absent from the model (particles: yaw, M) → the constant or 0,
     NaN on rows that were not solved."""
-    failed = status != 0
-    failed = failed if failed.any() else None
+    failed = (status != 0) if status.any() else None  # the mask only when a row failed
     result = {
         name: outs[name] if name in outs else _filler(failed, n, ks.constants.get(name, 0.0))
         for name in outputs
@@ -320,7 +324,10 @@ def _no_moment(columns) -> bool:
     if "e_m" not in columns or isinstance(columns["e_m"], str):
         return False
     em = np.asarray(columns["e_m"])
-    return em.dtype.kind in "fiu" and bool(np.all(em == 1.0))
+    if em.dtype.kind not in "fiu":
+        return False
+    # The first row decides most batches without a pass over the column.
+    return bool(em.flat[0] == 1.0) and bool(np.all(em == 1.0)) if em.size else True
 
 
 def _solve_mixed(columns, models, critical, names, tier: str) -> dict:

@@ -504,3 +504,28 @@ def test_an_interrupted_sweep_leaves_no_spill_file_and_no_traceback(tmp_path, si
     assert process.returncode == code
     assert err.decode() == f"impactsym: {said}\n"
     assert list(temp.iterdir()) == []
+
+
+def test_a_signal_inside_a_finaliser_is_sent_again_not_lost():
+    # Python drops an exception raised in __del__ (numba and llvmlite free compiler
+    # objects there), so a Ctrl-C landing there would be lost: the CLI's handler
+    # leaves it and sends the signal again once the finaliser has returned.
+    from impactsym import cli
+
+    received = []
+    previous = signal.signal(signal.SIGUSR1, lambda signum, frame: received.append(signum))
+    try:
+
+        class Finalised:
+            def __del__(self):
+                received.append(cli._deferred(signal.SIGUSR1, sys._getframe()))
+
+        Finalised()  # finalised at once (no other reference)
+        assert received == [True]
+        assert cli._deferred(signal.SIGUSR1, sys._getframe()) is False
+        deadline = time.monotonic() + 5
+        while len(received) < 2 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert received == [True, signal.SIGUSR1]
+    finally:
+        signal.signal(signal.SIGUSR1, previous)
