@@ -111,9 +111,21 @@ def energy_kernel(n: int) -> Kernel:
             Guard((sp.StrictLessThan(sp.Abs(alpha), PDOF_LIMIT),), "PDOF_BEYOND_LIMIT"),
         ),
         blocks=(
-            Block(((G, A**2 / (2 * B)), (alpha_c, sp.Min(sp.Abs(alpha), PDOF_CAP)))),
-            Block(((E_crush, profile_energy(n)),)),
-            Block(((E, E_crush * (1 + sp.tan(alpha_c) ** 2)), (E_woolley, E_crush / sp.cos(alpha_c)))),
+            Block(
+                ((G, A**2 / (2 * B)), (alpha_c, sp.Min(sp.Abs(alpha), PDOF_CAP))),
+                equation="no-damage energy G = A^2/(2B) (CRASH3 manual); alpha capped at 45 deg "
+                "(EDCRASH; Day & Hargens SAE 870045)",
+            ),
+            Block(
+                ((E_crush, profile_energy(n)),),
+                equation=f"{n}-point crush energy: F/w = A + B C integrated per segment "
+                "(CRASH3 manual; Day & Hargens SAE 870045)",
+            ),
+            Block(
+                ((E, E_crush * (1 + sp.tan(alpha_c) ** 2)), (E_woolley, E_crush / sp.cos(alpha_c))),
+                equation="oblique force: CRASH3's 1 + tan^2 alpha (CRASH3 manual; Day & Hargens SAE 870045), "
+                "Woolley's 1/cos alpha",
+            ),
         ),
         outputs=(E_crush, E, E_woolley),
         flags=(("PDOF_CAPPED", (sp.StrictGreaterThan(sp.Abs(alpha), PDOF_CAP),)),),
@@ -141,6 +153,10 @@ def delta_v_kernel(energy: str = "dissipated") -> Kernel:
     if energy == "dissipated":
         name, e_range = "crash3_delta_v", sp.StrictLessThan(e, 1)
         impulse = sp.sqrt(2 * E * (1 + e) / (ome * (ke1 + ke2)))
+        impulse_equation = (
+            "|P| = sqrt(2 E mbar (1 + e)/(1 - e)): E lost over the impact (CRASH3 at e = 0; "
+            "Rose et al. SAE 2006-01-0908)"
+        )
         doc = (
             "CRASH3 delta-V from the total crush energy E dissipated over the impact: 1-D "
             "impact of effective masses gamma_i*m_i along the PDOF, restitution e "
@@ -149,6 +165,9 @@ def delta_v_kernel(energy: str = "dissipated") -> Kernel:
     else:
         name, e_range = "crash3_delta_v_absorbed", sp.LessThan(e, 1)
         impulse = (1 + e) * sp.sqrt(2 * E / (ke1 + ke2))
+        impulse_equation = (
+            "|P| = (1 + e) sqrt(2 E mbar): E absorbed up to maximum crush (Rose et al. SAE 2006-01-0908)"
+        )
         doc = (
             "CRASH3 delta-V from the crush energy E absorbed up to maximum crush: approach "
             "impulse sqrt(2 E mbar), total (1 + e) times it (Rose et al., SAE 2006-01-0908)."
@@ -169,22 +188,30 @@ def delta_v_kernel(energy: str = "dissipated") -> Kernel:
                     (mass_factor1, 1 / (1 + (h1 / rg1) ** 2)),
                     (mass_factor2, 1 / (1 + (h2 / rg2) ** 2)),
                     (ome, 1 - e),
-                )
+                ),
+                equation="effective-mass factor gamma = k^2/(k^2 + h^2) (CRASH3 manual; Day & Hargens SAE 870045)",
             ),
             # 1/(γ m) = (1/m)(1 + h²/k²): exactly 0 for a fixed body.
             Block(
                 ((ke1, k1 * (1 + (h1 / rg1) ** 2)), (ke2, k2 * (1 + (h2 / rg2) ** 2))),
                 Guard((sp.StrictGreaterThan(ke1 + ke2, 0),), "SINGULAR"),
+                equation="inverse effective masses 1/(gamma m) = (1/m)(1 + h^2/k^2) (CRASH3 manual; Day & Hargens SAE 870045)",
             ),
-            Block(((P, impulse),)),
-            Block(((dV1, k1 * P), (dV2, k2 * P), (dV1_eff, ke1 * P), (dV2_eff, ke2 * P))),
+            Block(((P, impulse),), equation=impulse_equation),
+            Block(
+                ((dV1, k1 * P), (dV2, k2 * P), (dV1_eff, ke1 * P), (dV2_eff, ke2 * P)),
+                equation="dV_i = |P|/m_i (centre of gravity); |P|/(gamma_i m_i), EDCRASH's effective-mass "
+                "delta-V (Day & Hargens SAE 870045)",
+            ),
             Block(
                 (
                     (dV1x, -dV1 * sp.cos(gamma + alpha1)),
                     (dV1y, -dV1 * sp.sin(gamma + alpha1)),
                     (dV2x, dV2 * sp.cos(gamma + alpha2)),
                     (dV2y, dV2 * sp.sin(gamma + alpha2)),
-                )
+                ),
+                equation="delta-V vectors along each vehicle's PDOF, alpha_i from its inward normal "
+                "(conventions.md frame)",
             ),
         ),
         outputs=(P, dV1, dV2, mass_factor1, mass_factor2, dV1x, dV1y, dV2x, dV2y, dV1_eff, dV2_eff),
@@ -200,7 +227,13 @@ def moment_arm_kernel() -> Kernel:
         doc="Moment arm h = r x (cos theta, sin theta) of the PDOF about the centre of gravity.",
         inputs=(rx, ry, theta),
         checks=(finite_inputs((rx, ry, theta)),),
-        blocks=(Block(((h, rx * sp.sin(theta) - ry * sp.cos(theta)),)),),
+        blocks=(
+            Block(
+                ((h, rx * sp.sin(theta) - ry * sp.cos(theta)),),
+                equation="moment arm h = r x d of the PDOF about the CG, the h of gamma "
+                "(CRASH3 manual; Day & Hargens SAE 870045)",
+            ),
+        ),
         outputs=(h,),
     )
 
@@ -212,7 +245,7 @@ def radius_of_gyration_kernel() -> Kernel:
         doc="Radius of gyration k = sqrt(I/m).",
         inputs=(mass, inertia),
         checks=(finite_inputs((), (mass, inertia)), positive_or_fixed((mass, inertia))),
-        blocks=(Block(((rg, sp.sqrt(inertia / mass)),)),),
+        blocks=(Block(((rg, sp.sqrt(inertia / mass)),), equation="radius of gyration k = sqrt(I/m)"),),
         outputs=(rg,),
     )
 
@@ -225,7 +258,13 @@ def implied_pdof_kernel() -> Kernel:
         doc="PDOF implied by an impulse (Pn, Pt) on vehicle 1: alpha = atan2(-Pt, -Pn).",
         inputs=(Pn, Pt),
         checks=(finite_inputs((Pn, Pt)),),
-        blocks=(Block(((pdof, sp.atan2(-Pt, -Pn)),)),),
+        blocks=(
+            Block(
+                ((pdof, sp.atan2(-Pt, -Pn)),),
+                equation="PDOF = direction of the resultant impulse (seed, CRASH section): "
+                "tan alpha = Pt/Pn = mu (seed eq 5)",
+            ),
+        ),
         outputs=(pdof,),
     )
 

@@ -42,18 +42,35 @@ def _blocks():
         Block(
             f.inverse_masses((m1, m2, I1, I2), (k1, k2, j1, j2)) + f.normal_components(),
             Guard((sp.StrictGreaterThan(k1 + k2, 0),), "SINGULAR"),
+            equation="conventions.md frame: k = 1/m, j = 1/I, n = (cos gamma, sin gamma)",
         ),
-        Block(((r1n, r1n_), (r1t, r1t_), (r2n, r2n_), (r2t, r2t_))),
-        Block(((Cnn, C[0, 0]), (Cnt, C[0, 1]), (Ctt, C[1, 1]))),
+        Block(
+            ((r1n, r1n_), (r1t, r1t_), (r2n, r2n_), (r2t, r2t_)),
+            equation="arms in the impact frame: the seed's d_d, d_c (vehicle 1), d_b, d_a (vehicle 2) of eq 29",
+        ),
+        Block(
+            ((Cnn, C[0, 0]), (Cnt, C[0, 1]), (Ctt, C[1, 1])),
+            equation="compliance C of the impact centre from impulse-momentum (six equations 1, 2)",
+        ),
         # 1 - e as one rounded quantity (SymPy would flatten it into the sum).
-        Block(((D, Cnn + mu * Cnt), (ome, 1 - e)), Guard((sp.Ne(D, 0),), "SINGULAR")),
+        Block(
+            ((D, Cnn + mu * Cnt), (ome, 1 - e)),
+            Guard((sp.Ne(D, 0),), "SINGULAR"),
+            equation="D = Cnn + mu Cnt, so 1/q = mbar D (seed eq 29)",
+        ),
         Block(
             ((q, (k1 + k2) / D), (B, ome + 2 * mu * r - mu * (1 + e) * (Cnt + mu * Ctt) / D)),
             # T_L = Pn² D B / (2(1 + e)): a real |P| needs D·B > 0.
             Guard((sp.StrictGreaterThan(D * B, 0),), "ENERGY_INCONSISTENT"),
+            equation="q (seed eq 29); B, the denominator of seed eq 27 with mu^2 r/mu_max generalised",
         ),
-        Block(((P_abs, sp.sqrt(2 * (1 + mu**2) * (1 + e) * TL_in / (D * B))),)),
-        Block(((dV1, k1 * P_abs), (dV2, k2 * P_abs))),
+        Block(
+            ((P_abs, sp.sqrt(2 * (1 + mu**2) * (1 + e) * TL_in / (D * B))),),
+            equation="|P| = m1 dV1 from TL (seed eq 27)",
+        ),
+        Block(
+            ((dV1, k1 * P_abs), (dV2, k2 * P_abs)), equation="dV1 (seed eq 27); dV2 = m1 dV1/m2 (seed eq 28)"
+        ),
     )
 
 

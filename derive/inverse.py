@@ -111,6 +111,8 @@ def _rigid_blocks():
                 + f.normal_components()
                 + ((dVx, V2x - V1x), (dVy, V2y - V1y), (Wr, W2 - W1), (drx, r1x - r2x), (dry, r1y - r2y)),
                 Guard((sp.StrictGreaterThan(k1 + k2, 0), sp.StrictGreaterThan(j1 + j2, 0)), "SINGULAR"),
+                equation="conventions.md frame: k = 1/m, j = 1/I, n = (cos gamma, sin gamma); "
+                "V2 - V1, W2 - W1",
             ),
             Block(
                 (
@@ -121,7 +123,9 @@ def _rigid_blocks():
                     (Gx, final_rel[0]),
                     (Gy, final_rel[1]),
                     (Jsum, C[2, 2]),
-                )
+                ),
+                equation="arms in the impact frame; U2 - U1 at the impact centre at separation, "
+                "U_i = V_i + W_i z x r_i",
             ),
         )
         + planar.compliance_pieces()
@@ -137,10 +141,20 @@ def _rigid_blocks():
                     (M, (1 - e_m) * Wr / (e_m * Jsum)),
                 ),
                 _separating_guard(),
+                equation="compliance C (six equations 1, 2); M from moment restitution "
+                "(six equations 5) solved for M",
             ),
-            Block(((Dn, Cnn + mu * Cnt), (dgn_inv, (1 + e) * Gn / e)), Guard((sp.Ne(Dn, 0),), "SINGULAR")),
-            Block(((Pn, -(dgn_inv + Cnm * M) / Dn),)),
-            Block(((Pt, mu * Pn),)),
+            Block(
+                ((Dn, Cnn + mu * Cnt), (dgn_inv, (1 + e) * Gn / e)),
+                Guard((sp.Ne(Dn, 0),), "SINGULAR"),
+                equation="restitution (seed eq 3) solved for the approach: gn - Gn = -(1 + e) Gn/e, "
+                "e in the denominator",
+            ),
+            Block(
+                ((Pn, -(dgn_inv + Cnm * M) / Dn),),
+                equation="Pn from gn - Gn = Cnn Pn + Cnt Pt + Cnm M with Pt = mu Pn (seed eq 5, six equations 4)",
+            ),
+            Block(((Pt, mu * Pn),), equation="impulse ratio Pt = mu Pn (seed eq 5, six equations 4)"),
             Block(
                 (
                     (Px, px),
@@ -150,7 +164,8 @@ def _rigid_blocks():
                     (gn, gn_),
                     (gt, Gt + Cnt * Pn + Ctt * Pt + Ctm * M),
                     (wr, Wr + Cnm * Pn + Ctm * Pt + Jsum * M),
-                )
+                ),
+                equation="P in the scene frame; initial relative motion (gn, gt, wr) = final + C (Pn, Pt, M)",
             ),
             Block(
                 (
@@ -164,9 +179,11 @@ def _rigid_blocks():
                     (TLn, Pn * sp.factor(gn_ + Gn) / 2),
                     (TLt, Pt * (gt + Gt) / 2),
                     (TLm, M * (wr + Wr) / 2),
-                )
+                ),
+                equation="initial velocities (six equations 1, 2); work of Pn, Pt, M "
+                "(seed eqs 21-26, conventions.md energy)",
             ),
-            Block(((TL, TLn + TLt + TLm),)),
+            Block(((TL, TLn + TLt + TLm),), equation="TL = TLn + TLt + TLm (conventions.md energy)"),
             # μ_c of the recovered scene: the forward kernel's sticking ratio.
         )
         + planar.critical_ratio_blocks()
@@ -182,14 +199,23 @@ def _particle_blocks():
             + f.normal_components()
             + ((dVx, V2x - V1x), (dVy, V2y - V1y)),
             Guard((sp.StrictGreaterThan(k1 + k2, 0),), "SINGULAR"),
+            equation="conventions.md frame: k = 1/m, n = (cos gamma, sin gamma); final relative velocity V2 - V1",
         ),
-        Block(((Gn, dVx * nx + dVy * ny), (Gt, dVy * nx - dVx * ny), (kk, k1 + k2)), _separating_guard()),
-        Block(((Pn, -(1 + e) * Gn / (e * kk)),)),
-        Block(((Pt, mu * Pn),)),
+        Block(
+            ((Gn, dVx * nx + dVy * ny), (Gt, dVy * nx - dVx * ny), (kk, k1 + k2)),
+            _separating_guard(),
+            equation="separation in the impact frame (seed Fig. 1); kk = 1/m1 + 1/m2",
+        ),
+        Block(
+            ((Pn, -(1 + e) * Gn / (e * kk)),),
+            equation="Pn from restitution (seed eq 3) and eq 4 solved for the approach: e in the denominator",
+        ),
+        Block(((Pt, mu * Pn),), equation="impulse ratio Pt = mu Pn (seed eq 5)"),
         # gn = -Gn/e < 0, unless it underflows (e huge): mu_c divides by it.
         Block(
             ((Px, px), (Py, py), (gn, gn_), (gt, Gt + kk * Pt)),
             Guard((sp.StrictLessThan(gn, 0),), "NOT_APPROACHING"),
+            equation="P in the scene frame; initial approach gn = -Gn/e (seed eq 3), gt = Gt + kk Pt (seed eq 6)",
         ),
         Block(
             (
@@ -200,9 +226,10 @@ def _particle_blocks():
                 (TLn, Pn * sp.factor(gn_ + Gn) / 2),
                 (TLt, Pt * (gt + Gt) / 2),
                 (mu_c, gt / ((1 + e) * gn)),
-            )
+            ),
+            equation="initial velocities (seed eqs 4, 6); work of Pn, Pt (seed eqs 21-26); mu_max (seed eq 18)",
         ),
-        Block(((TL, TLn + TLt),)),
+        Block(((TL, TLn + TLt),), equation="TL = TLn + TLt (conventions.md energy)"),
     )
 
 

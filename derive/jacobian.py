@@ -67,7 +67,8 @@ def jacobian_kernel(base: Kernel, name: str | None = None) -> Kernel:
                 derived.append((dsym, value))
                 tangents[sym][x] = dsym
         if derived:
-            blocks.append(Block(tuple(derived)))
+            label = f"d/d(inputs) of: {block.equation}" if block.equation else ""
+            blocks.append(Block(tuple(derived), equation=label))
     outputs, zeros = [], []
     for out in base.outputs:
         for x in wrt:

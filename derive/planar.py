@@ -213,7 +213,10 @@ def compliance_pieces():
     drn_, drt_ = f.to_impact_frame(drx, dry)
     C = compliance()
     return (
-        Block(((drn, drn_), (drt, drt_), (kk, k1 + k2), (jbar, j1 * j2 / (j1 + j2)))),
+        Block(
+            ((drn, drn_), (drt, drt_), (kk, k1 + k2), (jbar, j1 * j2 / (j1 + j2))),
+            equation="arms r1 - r2 in the impact frame; kk = 1/m1 + 1/m2, jbar = j1 j2/(j1 + j2)",
+        ),
         Block(
             (
                 (am, (1 - e_m) / C[2, 2]),
@@ -222,7 +225,9 @@ def compliance_pieces():
                 (wc, (1 - e_m) * jbar),
                 (Cnm, C[0, 2]),
                 (Ctm, C[1, 2]),
-            )
+            ),
+            equation="compliance C from impulse-momentum (six equations 1, 2); "
+            "moment restitution (six equations 5)",
         ),
     )
 
@@ -232,10 +237,20 @@ def critical_ratio_blocks():
     known: the effective compliance, then the sticking ratio (Pt/Pn with zero
     final slip), with its denominator guarded."""
     return (
-        Block(tuple(effective_compliance().items())),
-        Block(((bn, (1 + e) * gn - hn), (bt, gt - ht))),
-        Block(((Dc, Ktt * bn - Knt * bt),), Guard((sp.Ne(Dc, 0),), "SINGULAR")),
-        Block(((mu_c, (Knn * bt - Knt * bn) / Dc),)),
+        Block(tuple(effective_compliance().items()), equation="effective compliance K (M eliminated)"),
+        Block(
+            ((bn, (1 + e) * gn - hn), (bt, gt - ht)),
+            equation="K (Pn, Pt) = (bn, bt): restitution (seed eq 3) and no sliding at separation (seed eq 8)",
+        ),
+        Block(
+            ((Dc, Ktt * bn - Knt * bt),),
+            Guard((sp.Ne(Dc, 0),), "SINGULAR"),
+            equation="Pn of the sticking solution (Cramer's rule, det K cancels)",
+        ),
+        Block(
+            ((mu_c, (Knn * bt - Knt * bn) / Dc),),
+            equation="mu_c = Pt/Pn of the sticking solution, the seed's mu_max (eq 18) generalised",
+        ),
     )
 
 

@@ -171,9 +171,17 @@ def _frame_blocks():
             + f.normal_components()
             + ((dvx, v2x - v1x), (dvy, v2y - v1y), (r12, r1x * r2y - r1y * r2x)),
             Guard((sp.StrictGreaterThan(k1 + k2, 0), sp.StrictGreaterThan(j1 + j2, 0)), "SINGULAR"),
+            equation="conventions.md frame: k = 1/m, j = 1/I, n = (cos gamma, sin gamma)",
         ),
-        Block(((r1n, r1n_), (r1t, r1t_), (r2n, r2n_), (r2t, r2t_), (gx, gx_), (gy, gy_), (kk, k1 + k2))),
-        Block(((gn, gn_), (gt, gt_)), f.approach_guard()),
+        Block(
+            ((r1n, r1n_), (r1t, r1t_), (r2n, r2n_), (r2t, r2t_), (gx, gx_), (gy, gy_), (kk, k1 + k2)),
+            equation="arms in the impact frame; u2 - u1 at the impact centre, u_i = v_i + w_i z x r_i",
+        ),
+        Block(
+            ((gn, gn_), (gt, gt_)),
+            f.approach_guard(),
+            equation="approach at the impact centre in the impact frame (conventions.md frame)",
+        ),
     )
 
 
@@ -187,11 +195,14 @@ def _impulse_blocks():
     return (
         Block(
             tuple(keff.items())
-            + ((D, planar.effective_determinant().xreplace(NO_MOMENT)), (bn, gn), (bt, (1 - slip) * gt))
+            + ((D, planar.effective_determinant().xreplace(NO_MOMENT)), (bn, gn), (bt, (1 - slip) * gt)),
+            equation="K at e_m = 1 (M = 0); IMPAC sideswipe constraint (seed, Woolley): Gn = 0 (e = 0), "
+            "Gt = slip gt",
         ),
         Block(
             ((Dc, Ktt * bn - Knt * bt), (Dcrit, Ktt * bn - Knt * gt)),
             Guard((sp.Ne(D, 0), sp.Ne(Dc, 0), sp.Ne(Dcrit, 0)), "SINGULAR"),
+            equation="Cramer's rule for K (Pn, Pt) = (bn, bt), and for the common-velocity (slip = 0) impulse",
         ),
         Block(
             (
@@ -199,7 +210,9 @@ def _impulse_blocks():
                 (Pt, (Knn * bt - Knt * bn) / D),
                 (mu_used, (Knn * bt - Knt * bn) / Dc),
                 (mu_c, (Knn * gt - Knt * bn) / Dcrit),
-            )
+            ),
+            equation="impulses; mu = Pt/Pn (seed eq 5); mu_c of the common-velocity impulse, the seed's "
+            "mu_max (eq 18)",
         ),
     )
 
@@ -223,7 +236,8 @@ def _final_blocks():
                 *f.delta_v_magnitudes(),
                 (TLn, Pn * gn / 2),
                 (TLt, Pt * (1 + slip) * gt / 2),
-            )
+            ),
+            equation="P in the scene frame; dV = |P|/m; M = 0; work of Pn, Pt (seed eqs 21-26)",
         ),
         Block(
             (
@@ -234,9 +248,10 @@ def _final_blocks():
                 (W1, w1 + j1 * c1),
                 (W2, w2 - j2 * c2),
                 (TLm, sp.Integer(0)),
-            )
+            ),
+            equation="final velocities from impulse-momentum (six equations 1, 2)",
         ),
-        Block(((TL, TLn + TLt),)),
+        Block(((TL, TLn + TLt),), equation="TL = TLn + TLt (conventions.md energy)"),
     )
 
 

@@ -136,17 +136,22 @@ def _blocks():
                     (Wr, W2 - W1),
                     (dVx, V2x - V1x),
                     (dVy, V2y - V1y),
-                )
+                ),
+                equation="frame (conventions.md); headings h_i = (cos theta_i, sin theta_i); "
+                "momentum p = m1 V1 + m2 V2",
             ),
             Block(
                 ((hcross, h1x * h2y - h1y * h2x), (r1n, r1n_), (r1t, r1t_), (r2n, r2n_), (r2t, r2t_)),
                 Guard((sp.StrictGreaterThan(sp.Abs(hcross), COLLINEAR),), "HEADINGS_COLLINEAR"),
+                equation="h1 x h2 (collinear headings do not fix the speeds); arms in the impact frame",
             ),
             Block(
                 (
                     (s1, (px_tot * h2y - py_tot * h2x) / (m1 * hcross)),
                     (s2, (h1x * py_tot - h1y * px_tot) / (m2 * hcross)),
-                )
+                ),
+                equation="speeds from linear momentum m1 s1 h1 + m2 s2 h2 = p (seed eqs 1, 2; "
+                "six equations 1), by Cramer's rule",
             ),
             Block(
                 (
@@ -156,7 +161,8 @@ def _blocks():
                     (v2y, s2 * h2y),
                     (f.dvx, s2 * h2x - s1 * h1x),
                     (f.dvy, s2 * h2y - s1 * h1y),
-                )
+                ),
+                equation="initial velocities v_i = s_i h_i",
             ),
             Block(
                 (
@@ -168,6 +174,8 @@ def _blocks():
                     (Gt, f.to_impact_frame(*G)[1]),
                 ),
                 f.approach_guard(),
+                equation="P = m1 (V1 - v1) (seed eqs 4, 6; six equations 1); u2 - u1 at the impact "
+                "centre, before and after",
             ),
             Block(
                 (
@@ -182,20 +190,28 @@ def _blocks():
                     (pdof2, sp.atan2(Py, Px) - theta2),
                 ),
                 Guard((sp.Ne(Pn, 0),), "SINGULAR"),
+                equation="M_i from each angular impulse (six equations 2); e = -Gn/gn (seed eq 3); "
+                "PDOF of the impulse",
             ),
-            Block(((M, (M1 + M2) / 2), (M_residual, M1 - M2), (mu, Pt / Pn))),
+            Block(
+                ((M, (M1 + M2) / 2), (M_residual, M1 - M2), (mu, Pt / Pn)),
+                equation="M = mean of the two angular impulse equations, M_residual their difference; "
+                "mu = Pt/Pn (seed eq 5)",
+            ),
             Block(
                 (
                     (e_m, sp.Piecewise((1, sp.Eq(em_den, 0)), (Wr / em_den, True))),
                     (TLn, Pn * (gn + Gn) / 2),
                     (TLt, Pt * (gt + Gt) / 2),
                     (TLm, M * (wr + Wr) / 2),
-                )
+                ),
+                equation="moment restitution (six equations 5) solved for e_m; work of Pn, Pt, M "
+                "(seed eqs 21-26, conventions.md energy)",
             ),
         )
         + planar.compliance_pieces()
         + planar.critical_ratio_blocks()
-        + (Block(((TL, TLn + TLt + TLm),)),)
+        + (Block(((TL, TLn + TLt + TLm),), equation="TL = TLn + TLt + TLm (conventions.md energy)"),)
     )
 
 

@@ -37,8 +37,14 @@ KERNELS = (
             Guard(tuple(sp.GreaterThan(sp.Symbol(i.name), 0) for i in (I1, I2)), "BAD_MASS"),
         ),
         blocks=(
-            Block(((T1, _body_energy(m1, I1, v1x, v1y, w1)), (T2, _body_energy(m2, I2, v2x, v2y, w2)))),
-            Block(((T, T1 + T2),)),
+            Block(
+                ((T1, _body_energy(m1, I1, v1x, v1y, w1)), (T2, _body_energy(m2, I2, v2x, v2y, w2))),
+                equation="kinetic energy of each vehicle, m |v|^2/2 (seed eq 16) plus yaw I w^2/2",
+            ),
+            Block(
+                ((T, T1 + T2),),
+                equation="initial system energy, the reference of energy loss percentages (seed Tables 1, 6)",
+            ),
         ),
         outputs=(T, T1, T2),
     ),

@@ -99,6 +99,34 @@ def test_manifest_describes_every_kernel():
     assert p.MANIFEST["rigid_velocities"]["tier"] == "velocities"
 
 
+def _emitted_kernels():
+    """(module name, kernel) for every kernel python -m derive emits."""
+    import importlib
+
+    for name in derive_main.MODEL_MODULES:
+        mod = importlib.import_module(f"derive.{name}")
+        for knl in getattr(mod, "EMITTED", mod.KERNELS):
+            yield name, knl
+
+
+def test_every_block_names_the_equation_it_implements():
+    """Each block of each emitted kernel carries an `equation` label (the
+    comment above it in generated/), and the committed MANIFEST lists one
+    label per block, so generated/ was rendered from labelled blocks."""
+    import importlib
+
+    unlabelled = [
+        f"{name}.{knl.name} block {i} ({', '.join(str(s) for s, _ in block.assigns[:3])})"
+        for name, knl in _emitted_kernels()
+        for i, block in enumerate(knl.blocks)
+        if not block.equation.strip()
+    ]
+    assert not unlabelled, f"blocks without an equation label: {unlabelled}"
+    for name, knl in _emitted_kernels():
+        manifest = importlib.import_module(f"generated.{name}").MANIFEST[knl.name]
+        assert manifest["equations"] == tuple(b.equation for b in knl.blocks), (name, knl.name)
+
+
 def test_generated_files_carry_the_header():
     digest = emit.source_hash()
     for name in derive_main.render_all():
