@@ -50,28 +50,12 @@ from pathlib import Path
 
 import numpy as np
 
+from impactsym.testing.reference import OUTPUTS as REFERENCE_OUTPUTS
+from impactsym.testing.reference import RIGID_INPUTS
+
 RESULTS = Path(__file__).resolve().parent / "results"
-OUTPUTS = ("V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M", "mu", "mu_c", "TL", "TLn", "TLt", "TLm")
-INPUTS = (
-    "m1",
-    "m2",
-    "I1",
-    "I2",
-    "v1x",
-    "v1y",
-    "w1",
-    "v2x",
-    "v2y",
-    "w2",
-    "r1x",
-    "r1y",
-    "r2x",
-    "r2y",
-    "gamma",
-    "e",
-    "mu",
-    "e_m",
-)
+OUTPUTS = tuple(REFERENCE_OUTPUTS)
+INPUTS = tuple(RIGID_INPUTS)
 SET_NAMES = ("realistic", "stress")
 EXACT_Y = 1e-19  # where an error of exactly 0 is drawn
 FAIL_Y = 1e3  # where a failed (infinite) error is drawn
