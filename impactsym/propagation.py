@@ -399,32 +399,41 @@ def uncertainty(
     draws: int = 10_000,
     seed: int | None = None,
     sobol: bool = False,
-    restitution: float = 0.0,
+    restitution: float | None = None,
     energy: str | None = None,
     correction: str | None = None,
 ) -> Uncertainty:
     """Uncertainty of ``command``'s answers for a scene whose leaves carry
     distributions (see the module docstring and conventions.md, Uncertainty).
-    ``restitution``, ``energy``, ``correction``: CRASH3's options (crash3
-    only; the uncertainty of CRASH3 supports its default energy treatment,
-    dissipated, and the 1 + tan²α correction)."""
-    if energy not in (None, "dissipated") or correction not in (None, "crash3"):
-        raise ValueError(
-            "--uncertainty of crash3 supports energy 'dissipated' and correction "
-            f"'crash3' only, got energy {energy!r}, correction {correction!r}"
-        )
-    return propagate(scene_source(scene, command, restitution), draws=draws, seed=seed, sobol=sobol)
+    ``restitution``, ``energy`` ("dissipated" | "absorbed") and
+    ``correction`` ("crash3" | "woolley"): CRASH3's options (crash3 only),
+    overriding the scene's ``"crash3"`` object as in `impactsym.crash3`."""
+    return propagate(
+        scene_source(scene, command, restitution, energy, correction), draws=draws, seed=seed, sobol=sobol
+    )
 
 
-def scene_source(scene, command: str, restitution: float = 0.0) -> Source:
-    """The Source of a scene (path, mapping or Scene) for a command."""
-    from .scene import load_scene, scene_columns
+def scene_source(
+    scene,
+    command: str,
+    restitution: float | None = None,
+    energy: str | None = None,
+    correction: str | None = None,
+) -> Source:
+    """The Source of a scene (path, mapping or Scene) for a command; for
+    crash3 with the scene's CRASH3 options overridden by those given."""
+    from .crash3 import crash3_options
+    from .scene import load_scene, scene_columns, scene_data
 
     kind = {"solve": "forward", "invert": "inverse", "reconstruct": "reconstruct", "crash3": "crash3"}.get(
         command
     )
     if kind is None:
         raise ValueError(f"command: unknown command {command!r} (use one of {', '.join(COMMANDS)})")
+    options = {}
+    if command == "crash3":
+        opts = crash3_options(scene_data(scene), restitution, energy, correction)
+        options = {"restitution": opts.restitution, "energy": opts.energy, "correction": opts.correction}
     parsed = load_scene(scene, kind=kind)
     inputs = tuple(Input(path, kind_, tuple(params)) for path, kind_, params in parsed.uncertain)
 
@@ -433,7 +442,7 @@ def scene_source(scene, command: str, restitution: float = 0.0) -> Source:
         return sc.columns, sc.reason
 
     return Source(
-        command_for(command, parsed.model, parsed.units, restitution),
+        command_for(command, parsed.model, parsed.units, **options),
         inputs,
         columns,
         tuple(getattr(parsed, "correlations", ())),
