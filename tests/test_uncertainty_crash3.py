@@ -295,4 +295,6 @@ def test_a_bad_option_is_a_one_line_error(tmp_path):
     assert run.returncode == 2
     assert run.stderr.count("\n") == 1 and "correction" in run.stderr
     with pytest.raises(ValueError, match="crash3.energy"):
-        impactsym.uncertainty({**_near_linear_scene("dissipated", "crash3"), "crash3": {"energy": "x"}}, "crash3")
+        impactsym.uncertainty(
+            {**_near_linear_scene("dissipated", "crash3"), "crash3": {"energy": "x"}}, "crash3"
+        )
