@@ -3,7 +3,7 @@
 `summary_frame` turns order statistics into the summary DataFrame (one row per
 column, one column per percentile), with numpy.percentile's 'linear'
 arithmetic step by step, so a streamed summary equals numpy's to the bit.
-`InMemory` selects order statistics with `numpy.partition`; `StreamSummary`
+`InMemory` selects order statistics in memory (`impactsym._selection`); `StreamSummary`
 spills the values of solved rows to files and `OrderStatistics` selects from
 them by radix passes over order-preserving 64-bit keys.
 """
@@ -17,7 +17,16 @@ import numpy as np
 
 from .scene import show_value
 
-__all__ = ["add_counts", "check_q", "counts", "summary_frame", "InMemory", "StreamSummary", "OrderStatistics"]
+__all__ = [
+    "add_counts",
+    "check_q",
+    "counts",
+    "percentiles",
+    "summary_frame",
+    "InMemory",
+    "StreamSummary",
+    "OrderStatistics",
+]
 
 
 def check_q(q) -> tuple[float, ...]:
@@ -97,15 +106,24 @@ def _interpolate(stat, q: tuple[float, ...]) -> np.ndarray:
     return result
 
 
-class InMemory:
-    """Order statistics of values held in memory (`numpy.partition`)."""
+def percentiles(parts: list[np.ndarray], q: tuple[float, ...]) -> np.ndarray:
+    """numpy.percentile(concatenation of `parts`, q) (the 'linear' method),
+    equal to it to the bit, without concatenating or sorting the parts."""
+    return _interpolate(InMemory(parts), q)
 
-    def __init__(self, values: np.ndarray):
-        self.values, self.count = values, values.size
+
+class InMemory:
+    """Order statistics of values held in memory: an array or a list of
+    arrays (`impactsym._selection`: exactly `numpy.partition`'s values)."""
+
+    def __init__(self, values):
+        self.parts = list(values) if isinstance(values, (list, tuple)) else [values]
+        self.count = sum(int(np.size(p)) for p in self.parts)
 
     def select(self, ranks: list[int]) -> dict[int, float]:
-        part = np.partition(self.values, ranks)
-        return {rank: float(part[rank]) for rank in ranks}
+        from ._selection import select_ranks
+
+        return select_ranks(self.parts, ranks)
 
 
 class StreamSummary:

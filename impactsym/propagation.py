@@ -140,22 +140,24 @@ def propagate(
     rejected: dict[str, int] = {}
     accepted, kept, kept_rows = 0, [], 0
     step = max(BLOCK, (chunk_size // BLOCK) * BLOCK)
+    correlated = not np.array_equal(factor, np.eye(len(source.inputs)))
     for start in range(0, draws, step):
         stop = min(start + step, draws)
-        scores = factor @ np.vstack(plan.draws(start, stop))
-        overrides = {x.path: x.from_scores(z) for x, z in zip(source.inputs, scores)}
+        scores = plan.draws_into(start, stop, np.empty((len(source.inputs), stop - start)))
+        if correlated:  # (the identity factor would give the same numbers)
+            scores = factor @ scores
+        overrides = {x.path: x.from_scores(z, in_place=True) for x, z in zip(source.inputs, scores)}
         ok, values = _run_chunk(source, overrides, rejected)
-        accepted += int(ok.sum())
+        rows = np.flatnonzero(ok)
+        accepted += rows.size
+        # The accepted values, selected once: Stats keeps them (no copy) and
+        # so does the caller's table of draws while it has room.
+        chosen = {p: np.asarray(v, dtype=np.float64).take(rows) for p, v in values.items()}
         for path, s in stats.items():
-            s.add(np.asarray(values[path], dtype=np.float64)[ok])
+            s.add(chosen[path], owned=True)
         if kept_rows < KEEP:
-            kept_rows += int(ok.sum())
-            kept.append(
-                {
-                    **{p: v[ok] for p, v in overrides.items()},
-                    **{p: np.broadcast_to(v, ok.shape)[ok] for p, v in values.items()},
-                }
-            )
+            kept_rows += rows.size
+            kept.append({**{p: v.take(rows) for p, v in overrides.items()}, **chosen})
     gradient = _gradients(source, nominal)
     cov = corr * np.outer([x.sd for x in source.inputs], [x.sd for x in source.inputs])
     outputs, budget = {}, {}
@@ -198,12 +200,13 @@ def _run_chunk(source: Source, overrides: dict, rejected: dict):
         path: np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
         for path, v in source.command.outputs(columns, outs).items()
     }
-    ok = np.ones(n, dtype=bool)
-    reason = np.broadcast_to(np.asarray(reason, dtype=object), (n,))
-    bad_leaf = reason != ""
-    for text in np.unique(reason[bad_leaf]).tolist():
-        _count(rejected, text, int(np.count_nonzero(reason == text)))
-    ok &= ~bad_leaf
+    reason = np.asarray(reason)
+    bad_leaf = np.broadcast_to(reason != "", (n,))
+    ok = ~bad_leaf
+    if not ok.all():
+        reason = np.broadcast_to(reason, (n,))
+        for text in np.unique(reason[bad_leaf]).tolist():
+            _count(rejected, text, int(np.count_nonzero(reason == text)))
     for code in np.unique(status[ok & (status != 0)]).tolist():
         _count(rejected, STATUS_NAMES[int(code)].lower(), int(np.count_nonzero(ok & (status == code))))
     ok &= status == 0
