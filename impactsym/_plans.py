@@ -275,7 +275,7 @@ class SamplePlan(_Plan):
         parameter, stop - start columns): the same values, without the
         per-block copies; a standard normal of a whole block is drawn in place
         (``rng.standard_normal(out=…)`` gives the values of
-        ``rng.normal(0.0, 1.0, size=BLOCK)``, tests/test_uncertainty_speed.py)."""
+        ``rng.normal(0.0, 1.0, size=BLOCK)``, tests/test_uncertainty_exact.py)."""
         for b in range(start // BLOCK, (stop - 1) // BLOCK + 1):
             lo, hi = max(start, b * BLOCK) - b * BLOCK, min(stop, (b + 1) * BLOCK) - b * BLOCK
             at = b * BLOCK + lo - start

@@ -108,8 +108,12 @@ def _interpolate(stat, q: tuple[float, ...]) -> np.ndarray:
 
 def percentiles(parts: list[np.ndarray], q: tuple[float, ...]) -> np.ndarray:
     """numpy.percentile(concatenation of `parts`, q) (the 'linear' method),
-    equal to it to the bit, without concatenating or sorting the parts."""
-    return _interpolate(InMemory(parts), q)
+    equal to it to the bit, without concatenating or sorting the parts (a
+    NaN among the values makes every percentile NaN, as in numpy)."""
+    stat = InMemory(parts)
+    if any(np.isnan(p.min()) for p in stat.parts if p.size):
+        return np.full(len(q), np.nan)
+    return _interpolate(stat, q)
 
 
 class InMemory:
