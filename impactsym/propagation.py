@@ -43,7 +43,9 @@ fraction so replaced is reported.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable, Mapping
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -71,6 +73,9 @@ __all__ = [
     "propagate",
     "uncertainty",
 ]
+
+#: Threads drawing the blocks of a chunk.
+DRAW_THREADS = min(4, os.cpu_count() or 1)
 
 #: Flags that make a draw physically impossible (ill-conditioned headings only warn).
 REJECTING_FLAGS = (
@@ -136,28 +141,7 @@ def propagate(
         entropy=entropy,
         rows=draws,
     )
-    stats = {path: Stats(value) for path, value in nominal["outputs"].items()}
-    rejected: dict[str, int] = {}
-    accepted, kept, kept_rows = 0, [], 0
-    step = max(BLOCK, (chunk_size // BLOCK) * BLOCK)
-    correlated = not np.array_equal(factor, np.eye(len(source.inputs)))
-    for start in range(0, draws, step):
-        stop = min(start + step, draws)
-        scores = plan.draws_into(start, stop, np.empty((len(source.inputs), stop - start)))
-        if correlated:  # (the identity factor would give the same numbers)
-            scores = factor @ scores
-        overrides = {x.path: x.from_scores(z, in_place=True) for x, z in zip(source.inputs, scores)}
-        ok, values = _run_chunk(source, overrides, rejected)
-        rows = np.flatnonzero(ok)
-        accepted += rows.size
-        # The accepted values, selected once: Stats keeps them (no copy) and
-        # so does the caller's table of draws while it has room.
-        chosen = {p: np.asarray(v, dtype=np.float64).take(rows) for p, v in values.items()}
-        for path, s in stats.items():
-            s.add(chosen[path], owned=True)
-        if kept_rows < KEEP:
-            kept_rows += rows.size
-            kept.append({**{p: v.take(rows) for p, v in overrides.items()}, **chosen})
+    stats, accepted, rejected, kept = _monte_carlo(source, plan, factor, nominal, chunk_size)
     gradient = _gradients(source, nominal)
     cov = corr * np.outer([x.sd for x in source.inputs], [x.sd for x in source.inputs])
     outputs, budget = {}, {}
@@ -189,6 +173,51 @@ def propagate(
     if sobol:
         result.sobol = sobol_indices(source, draws, seed, stats)
     return result
+
+
+def _monte_carlo(source: Source, plan: SamplePlan, factor: np.ndarray, nominal: dict, chunk_size: int):
+    """The draws of `plan`, chunk by chunk: (Stats per output, accepted
+    count, rejected counts by reason, accepted draws kept for the caller)."""
+    stats = {path: Stats(value) for path, value in nominal["outputs"].items()}
+    rejected: dict[str, int] = {}
+    accepted, kept, kept_rows = 0, [], 0
+    draws = plan.rows
+    step = max(BLOCK, (chunk_size // BLOCK) * BLOCK)
+    correlated = not np.array_equal(factor, np.eye(len(source.inputs)))
+    with ThreadPoolExecutor(DRAW_THREADS) as pool:
+        for start in range(0, draws, step):
+            stop = min(start + step, draws)
+            scores = _scores(plan, start, stop, pool)
+            if correlated:  # (the identity factor would give the same numbers)
+                scores = factor @ scores
+            overrides = {x.path: x.from_scores(z, in_place=True) for x, z in zip(source.inputs, scores)}
+            ok, values = _run_chunk(source, overrides, rejected)
+            rows = np.flatnonzero(ok)
+            accepted += rows.size
+            # The accepted values, selected once: Stats keeps them (no copy) and
+            # so does the caller's table of draws while it has room.
+            chosen = {p: np.asarray(v, dtype=np.float64).take(rows) for p, v in values.items()}
+            for path, s in stats.items():
+                s.add(chosen[path], owned=True)
+            if kept_rows < KEEP:
+                kept_rows += rows.size
+                kept.append({**{p: v.take(rows) for p, v in overrides.items()}, **chosen})
+    return stats, accepted, rejected, kept
+
+
+def _scores(plan: SamplePlan, start: int, stop: int, pool: ThreadPoolExecutor) -> np.ndarray:
+    """Normal scores of draws start..stop-1 (start a multiple of BLOCK), one
+    row per input: each block from its own stream, blocks drawn on `pool`'s
+    threads (numpy releases the GIL while it fills an array; every block
+    writes its own columns, so the numbers do not depend on the threads)."""
+    out = np.empty((len(plan.dists), stop - start))
+
+    def block(a: int) -> None:
+        b = min(a + BLOCK, stop)
+        plan.draws_into(a, b, out[:, a - start : b - start])
+
+    list(pool.map(block, range(start, stop, BLOCK)))
+    return out
 
 
 def _run_chunk(source: Source, overrides: dict, rejected: dict):
