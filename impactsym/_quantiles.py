@@ -10,6 +10,7 @@ them by radix passes over order-preserving 64-bit keys.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -106,12 +107,18 @@ def _interpolate(stat, q: tuple[float, ...]) -> np.ndarray:
     return result
 
 
-def percentiles(parts: list[np.ndarray], q: tuple[float, ...]) -> np.ndarray:
+def percentiles(parts: list[np.ndarray], q: tuple[float, ...], bounds=None) -> np.ndarray:
     """numpy.percentile(concatenation of `parts`, q) (the 'linear' method),
     equal to it to the bit, without concatenating or sorting the parts (a
-    NaN among the values makes every percentile NaN, as in numpy)."""
-    stat = InMemory(parts)
-    if any(np.isnan(p.min()) for p in stat.parts if p.size):
+    NaN among the values makes every percentile NaN, as in numpy).
+    `bounds`: the values' (min, max) when the caller has them (a NaN in
+    either: some value is NaN)."""
+    stat = InMemory(parts, bounds)
+    if bounds is None:
+        nan = any(np.isnan(p.min()) for p in stat.parts if p.size)
+    else:
+        nan = math.isnan(bounds[0]) or math.isnan(bounds[1])
+    if nan:
         return np.full(len(q), np.nan)
     return _interpolate(stat, q)
 
@@ -120,14 +127,15 @@ class InMemory:
     """Order statistics of values held in memory: an array or a list of
     arrays (`impactsym._selection`: exactly `numpy.partition`'s values)."""
 
-    def __init__(self, values):
+    def __init__(self, values, bounds: tuple[float, float] | None = None):
         self.parts = list(values) if isinstance(values, (list, tuple)) else [values]
         self.count = sum(int(np.size(p)) for p in self.parts)
+        self.bounds = bounds
 
     def select(self, ranks: list[int]) -> dict[int, float]:
         from ._selection import select_ranks
 
-        return select_ranks(self.parts, ranks)
+        return select_ranks(self.parts, ranks, self.bounds)
 
 
 class StreamSummary:

@@ -56,15 +56,20 @@ def _bin_of(values: np.ndarray, lo: float, scale: float) -> np.ndarray:
     return np.where(b < SELECT_BINS - 1, np.minimum(np.floor(b), SELECT_BINS - 1), SELECT_BINS - 1)
 
 
-def select_ranks(parts: list[np.ndarray], ranks) -> dict[int, float]:
+def select_ranks(
+    parts: list[np.ndarray], ranks, bounds: tuple[float, float] | None = None
+) -> dict[int, float]:
     """{rank: value} for the 0-based `ranks` of the sorted concatenation of
-    the float64 arrays `parts` (module docstring)."""
+    the float64 arrays `parts` (module docstring). `bounds`: their minimum
+    and maximum when the caller knows them (and knows there is no NaN)."""
     parts = [np.ascontiguousarray(p, dtype=np.float64) for p in parts if np.size(p)]
     ranks = sorted(set(int(r) for r in ranks))
     n = sum(p.size for p in parts)
     if n < SELECT_MIN:
         return _partition(parts, ranks)
-    lo, hi = min(float(p.min()) for p in parts), max(float(p.max()) for p in parts)
+    if bounds is None:
+        bounds = min(float(p.min()) for p in parts), max(float(p.max()) for p in parts)
+    lo, hi = bounds
     scale = SELECT_BINS / (hi - lo) if hi > lo else math.inf
     if not (math.isfinite(lo) and math.isfinite(hi) and math.isfinite(scale)):
         return _partition(parts, ranks)

@@ -46,7 +46,9 @@ class Stats:
         self.s1 += float(d.sum())
         d *= d
         self.s2 += float(d.sum())
-        self.lo, self.hi = min(self.lo, float(x.min())), max(self.hi, float(x.max()))
+        low, high = float(x.min()), float(x.max())  # NaN if any value is NaN
+        self.lo = low if math.isnan(low) or low < self.lo else self.lo
+        self.hi = high if math.isnan(high) or high > self.hi else self.hi
         if self.hist is None and self.n <= KEEP:
             self.kept.append(x if owned else x.copy())
             self.kept_n = self.n
@@ -79,7 +81,7 @@ class Stats:
         if self.n == 0:
             return [math.nan] * len(q)
         if self.hist is None:  # exact: numpy.percentile's values, without sorting
-            return [float(v) for v in percentiles(self.kept, tuple(q))]
+            return [float(v) for v in percentiles(self.kept, tuple(q), (self.lo, self.hi))]
         return [self._from_histogram(p) for p in q]
 
     def _from_histogram(self, p: float) -> float:

@@ -69,3 +69,17 @@ def test_normal_transform_in_place_gives_the_same_numbers():
     x = Input("v", "normal", (17.3, 0.37))
     want = x.from_scores(z)
     assert np.array_equal(x.from_scores(z.copy(), in_place=True), want)
+
+
+@pytest.mark.parametrize("name,parts", list(_datasets()), ids=[d[0] for d in _datasets()])
+def test_streamed_stats_give_numpy_percentiles(name, parts):
+    """`Stats` fed chunk by chunk (its running extremes passed to the
+    selection) gives numpy.percentile of all the values."""
+    from impactsym.uncertainty_result import Stats
+
+    stats = Stats(0.0)
+    with np.errstate(over="ignore", invalid="ignore"):  # the sums of 1e300s and infinities
+        for p in parts:
+            stats.add(p)
+    got, want = stats.percentiles(Q), np.percentile(np.concatenate(parts), Q)
+    assert np.array_equal(got, want, equal_nan=True), (name, got, want)
