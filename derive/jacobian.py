@@ -115,7 +115,9 @@ def _chain_rule(expr: sp.Expr, tangents: dict) -> dict:
 
 
 # The kernels with derivatives: forward (given and critical μ), inverse,
-# reconstruction, CRASH3 energy and delta-V. Base (angle) form, every input.
+# reconstruction, CRASH3 energy (both oblique corrections: E and E_woolley are
+# outputs of the same kernel) and delta-V (energy dissipated or absorbed).
+# Base (angle) form, every input.
 BASES = (
     planar.KERNELS
     + particle.KERNELS
@@ -125,7 +127,8 @@ BASES = (
     + tuple(
         k
         for k in crash3.KERNELS
-        if k.name in ("crash3_delta_v", "crash3_moment_arm", "crash3_radius_of_gyration")
+        if k.name
+        in ("crash3_delta_v", "crash3_moment_arm", "crash3_radius_of_gyration", "crash3_delta_v_absorbed")
     )
 )
 
@@ -225,11 +228,58 @@ def _agrees(knl: Kernel, base: Kernel, rng: random.Random, points: int) -> bool:
     return False
 
 
+def _cap_agrees(knl: Kernel, base: Kernel, rng: random.Random) -> bool:
+    """The EDCRASH cap in a CRASH3 energy Jacobian (alpha_c = min(|α|, 45°)).
+    Beyond the cap (45° < |α| < 90°, random points) every derivative with
+    respect to α is exactly 0: the corrected energies no longer depend on α.
+    Exactly at |α| = 45° the derivative is a kink's: the kernel returns the
+    mean of the one-sided derivatives (SymPy's Heaviside(0) = 1/2), i.e. half
+    of SymPy's derivative of the uncapped forms E_crush/cos²α and
+    E_crush/cos α there, with the sign of α."""
+    alpha = crash3.alpha
+    corrected = {
+        real("E"): base.expanded(real("E_crush")) / sp.cos(alpha) ** 2,
+        real("E_woolley"): base.expanded(real("E_crush")) / sp.cos(alpha),
+    }
+    for _attempt in range(100):
+        point = _random_point(knl, rng)
+        beyond = dict(point)
+        beyond[alpha] = sp.Rational(rng.choice((-1, 1))) * (
+            sp.Rational(4, 5) + sp.Rational(rng.randint(1, 999), 1000) * sp.Rational(7, 10)
+        )
+        at_cap = [{**point, alpha: sign * sp.pi / 4} for sign in (1, -1)]
+        values = [_evaluate(knl, p) for p in (beyond, *at_cap)]
+        if any(v is None for v in values):
+            continue
+        ok = all(values[0].get(_tangent_symbol(out, alpha), 0) == 0 for out in base.outputs)
+        for p, v in zip(at_cap, values[1:]):
+            for out, formula in corrected.items():
+                one_sided = sp.diff(formula, alpha).xreplace(p)
+                want = sp.N(one_sided, DIGITS) / 2
+                got = v[_tangent_symbol(out, alpha)]
+                ok &= abs(got - want) <= PROOF_TOLERANCE * max(abs(want), 1)
+        return bool(ok)
+    return False
+
+
 def proofs():
     """(claim, passed): every Jacobian kernel's derivative outputs equal
-    SymPy's derivatives of its value kernel's outputs at random points."""
+    SymPy's derivatives of its value kernel's outputs at random points; the
+    CRASH3 energy derivatives beyond and at the EDCRASH cap."""
     rng = random.Random(20261123)
-    return [
+    capped = [
+        (
+            (
+                f"{knl.name}: d_E__d_alpha and d_E_woolley__d_alpha are 0 beyond the 45 deg cap "
+                "and, at +-45 deg exactly, half the uncapped one-sided derivative (the mean of "
+                "the two one-sided derivatives)"
+            ),
+            _cap_agrees(knl, base, rng),
+        )
+        for knl, base in zip(KERNELS, BASES)
+        if base.name.startswith("crash3_energy")
+    ]
+    return capped + [
         (
             (
                 f"{knl.name}: every d_output__d_input equals sympy.diff of the expanded "

@@ -272,6 +272,7 @@ JACOBIAN_KERNELS = (
     "crash3_delta_v",
     "crash3_moment_arm",
     "crash3_radius_of_gyration",
+    "crash3_delta_v_absorbed",
 )
 _LAZY: dict = {}
 

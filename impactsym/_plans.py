@@ -260,12 +260,32 @@ class SamplePlan(_Plan):
 
     repeated = ()  # drawn columns hardly ever repeat a value
 
+    def _stream(self, b: int) -> np.random.Generator:
+        """Block ``b``'s own stream (independent of every other block)."""
+        return np.random.Generator(np.random.PCG64(np.random.SeedSequence(self.entropy, spawn_key=(b,))))
+
     def block(self, b: int) -> list[np.ndarray]:
         """Block ``b``: BLOCK draws of each parameter, in the caller's units,
         from the block's own stream (independent of every other block)."""
-        seq = np.random.SeedSequence(self.entropy, spawn_key=(b,))
-        rng = np.random.Generator(np.random.PCG64(seq))
+        rng = self._stream(b)
         return [getattr(rng, kind)(*params, size=BLOCK) for kind, params in self.dists]
+
+    def draws_into(self, start: int, stop: int, out: np.ndarray) -> np.ndarray:
+        """`draws` written into the rows of ``out`` (float64, one row per
+        parameter, stop - start columns): the same values, without the
+        per-block copies; a standard normal of a whole block is drawn in place
+        (``rng.standard_normal(out=…)`` gives the values of
+        ``rng.normal(0.0, 1.0, size=BLOCK)``, tests/test_uncertainty_exact.py)."""
+        for b in range(start // BLOCK, (stop - 1) // BLOCK + 1):
+            lo, hi = max(start, b * BLOCK) - b * BLOCK, min(stop, (b + 1) * BLOCK) - b * BLOCK
+            at = b * BLOCK + lo - start
+            rng = self._stream(b)
+            for row, (kind, params) in zip(out, self.dists):
+                if kind == "normal" and tuple(params) == (0.0, 1.0) and (lo, hi) == (0, BLOCK):
+                    rng.standard_normal(out=row[at : at + BLOCK])
+                else:
+                    row[at : at + hi - lo] = getattr(rng, kind)(*params, size=BLOCK)[lo:hi]
+        return out
 
     def draws(self, start: int, stop: int) -> list[np.ndarray]:
         """Rows start..stop-1 of each parameter: slices of whole blocks."""

@@ -3,13 +3,14 @@
 `summary_frame` turns order statistics into the summary DataFrame (one row per
 column, one column per percentile), with numpy.percentile's 'linear'
 arithmetic step by step, so a streamed summary equals numpy's to the bit.
-`InMemory` selects order statistics with `numpy.partition`; `StreamSummary`
+`InMemory` selects order statistics in memory (`impactsym._selection`); `StreamSummary`
 spills the values of solved rows to files and `OrderStatistics` selects from
 them by radix passes over order-preserving 64-bit keys.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -17,7 +18,16 @@ import numpy as np
 
 from .scene import show_value
 
-__all__ = ["add_counts", "check_q", "counts", "summary_frame", "InMemory", "StreamSummary", "OrderStatistics"]
+__all__ = [
+    "add_counts",
+    "check_q",
+    "counts",
+    "percentiles",
+    "summary_frame",
+    "InMemory",
+    "StreamSummary",
+    "OrderStatistics",
+]
 
 
 def check_q(q) -> tuple[float, ...]:
@@ -97,15 +107,35 @@ def _interpolate(stat, q: tuple[float, ...]) -> np.ndarray:
     return result
 
 
-class InMemory:
-    """Order statistics of values held in memory (`numpy.partition`)."""
+def percentiles(parts: list[np.ndarray], q: tuple[float, ...], bounds=None) -> np.ndarray:
+    """numpy.percentile(concatenation of `parts`, q) (the 'linear' method),
+    equal to it to the bit, without concatenating or sorting the parts (a
+    NaN among the values makes every percentile NaN, as in numpy).
+    `bounds`: the values' (min, max) when the caller has them (a NaN in
+    either: some value is NaN)."""
+    stat = InMemory(parts, bounds)
+    if bounds is None:
+        nan = any(np.isnan(p.min()) for p in stat.parts if p.size)
+    else:
+        nan = math.isnan(bounds[0]) or math.isnan(bounds[1])
+    if nan:
+        return np.full(len(q), np.nan)
+    return _interpolate(stat, q)
 
-    def __init__(self, values: np.ndarray):
-        self.values, self.count = values, values.size
+
+class InMemory:
+    """Order statistics of values held in memory: an array or a list of
+    arrays (`impactsym._selection`: exactly `numpy.partition`'s values)."""
+
+    def __init__(self, values, bounds: tuple[float, float] | None = None):
+        self.parts = list(values) if isinstance(values, (list, tuple)) else [values]
+        self.count = sum(int(np.size(p)) for p in self.parts)
+        self.bounds = bounds
 
     def select(self, ranks: list[int]) -> dict[int, float]:
-        part = np.partition(self.values, ranks)
-        return {rank: float(part[rank]) for rank in ranks}
+        from ._selection import select_ranks
+
+        return select_ranks(self.parts, ranks, self.bounds)
 
 
 class StreamSummary:

@@ -86,6 +86,7 @@ __all__ = [
     "Crash3Result",
     "Crash3Vehicle",
     "Crash3Options",
+    "crash3_options",
     "Crush",
     "INCHES_PER_FOOT",
     "PDOF_MISMATCH_DEG",
@@ -117,9 +118,10 @@ CRUSH_KEYS = (
 ENERGY_MODES = ("dissipated", "absorbed")
 CORRECTIONS = ("crash3", "woolley")
 OPTION_KEYS = ("restitution", "energy", "correction")
-# The energy kernel's output for each correction.
-_CORRECTED = {"crash3": "E", "woolley": "E_woolley"}
-_DELTA_V = {"dissipated": _kernels.CRASH3_DELTA_V, "absorbed": _kernels.CRASH3_DELTA_V_ABSORBED}
+# The energy kernel's output for each correction, and the delta-V kernel for
+# each energy mode (also used by the uncertainty of CRASH3).
+CORRECTED_OUTPUT = {"crash3": "E", "woolley": "E_woolley"}
+DELTA_V_KERNELS = {"dissipated": _kernels.CRASH3_DELTA_V, "absorbed": _kernels.CRASH3_DELTA_V_ABSORBED}
 # Inches per scene length unit, for class k² (published in in²).
 _INCHES_PER_LENGTH = {"SI": 1.0 / 0.0254, "US": INCHES_PER_FOOT}
 
@@ -301,7 +303,7 @@ def crash3(
         values[f"m{number}"] = math.inf if vehicle.fixed else vehicle.mass
         values[f"rg{number}"] = _radius_of_gyration(vehicle, c, parsed.units)
         values[f"h{number}"] = _moment_arm(data, vehicle, c, gamma, geometry, number - 1)
-    out = _run(_DELTA_V[options.energy], values, "cannot compute the CRASH3 delta-V")
+    out = _run(DELTA_V_KERNELS[options.energy], values, "cannot compute the CRASH3 delta-V")
     implied = _implied(data, options.restitution) if geometry else None
     vehicles = tuple(
         _vehicle(v, c, energies[i], out, values, i + 1, implied, geometry)
@@ -313,6 +315,17 @@ def crash3(
         + list(parsed.warnings)
     )
     return Crash3Result(parsed.units, options, vehicles, values["E"], out["P"], warnings)
+
+
+def crash3_options(
+    scene: Scene | Mapping | str | Path,
+    restitution: float | None = None,
+    energy: str | None = None,
+    correction: str | None = None,
+) -> Crash3Options:
+    """The CRASH3 options of a scene (its ``"crash3"`` object) overridden by
+    the arguments given (not None), checked as :func:`crash3` checks them."""
+    return _options(scene_data(scene), restitution, energy, correction)
 
 
 def _options(data: Mapping, restitution, energy, correction) -> Crash3Options:
@@ -440,7 +453,7 @@ def _energy(crush: Crush, units: str, path: str, correction: str) -> tuple[float
     factor = ENERGY_FACTOR[units]
     return (
         out["E_crush"] * factor,
-        out[_CORRECTED[correction]] * factor,
+        out[CORRECTED_OUTPUT[correction]] * factor,
         bool(out["flags"] & FLAG_PDOF_CAPPED),
     )
 

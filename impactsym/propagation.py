@@ -43,7 +43,9 @@ fraction so replaced is reported.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable, Mapping
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -71,6 +73,9 @@ __all__ = [
     "propagate",
     "uncertainty",
 ]
+
+#: Threads drawing the blocks of a chunk.
+DRAW_THREADS = min(4, os.cpu_count() or 1)
 
 #: Flags that make a draw physically impossible (ill-conditioned headings only warn).
 REJECTING_FLAGS = (
@@ -136,26 +141,7 @@ def propagate(
         entropy=entropy,
         rows=draws,
     )
-    stats = {path: Stats(value) for path, value in nominal["outputs"].items()}
-    rejected: dict[str, int] = {}
-    accepted, kept, kept_rows = 0, [], 0
-    step = max(BLOCK, (chunk_size // BLOCK) * BLOCK)
-    for start in range(0, draws, step):
-        stop = min(start + step, draws)
-        scores = factor @ np.vstack(plan.draws(start, stop))
-        overrides = {x.path: x.from_scores(z) for x, z in zip(source.inputs, scores)}
-        ok, values = _run_chunk(source, overrides, rejected)
-        accepted += int(ok.sum())
-        for path, s in stats.items():
-            s.add(np.asarray(values[path], dtype=np.float64)[ok])
-        if kept_rows < KEEP:
-            kept_rows += int(ok.sum())
-            kept.append(
-                {
-                    **{p: v[ok] for p, v in overrides.items()},
-                    **{p: np.broadcast_to(v, ok.shape)[ok] for p, v in values.items()},
-                }
-            )
+    stats, accepted, rejected, kept = _monte_carlo(source, plan, factor, nominal, chunk_size)
     gradient = _gradients(source, nominal)
     cov = corr * np.outer([x.sd for x in source.inputs], [x.sd for x in source.inputs])
     outputs, budget = {}, {}
@@ -189,6 +175,51 @@ def propagate(
     return result
 
 
+def _monte_carlo(source: Source, plan: SamplePlan, factor: np.ndarray, nominal: dict, chunk_size: int):
+    """The draws of `plan`, chunk by chunk: (Stats per output, accepted
+    count, rejected counts by reason, accepted draws kept for the caller)."""
+    stats = {path: Stats(value) for path, value in nominal["outputs"].items()}
+    rejected: dict[str, int] = {}
+    accepted, kept, kept_rows = 0, [], 0
+    draws = plan.rows
+    step = max(BLOCK, (chunk_size // BLOCK) * BLOCK)
+    correlated = not np.array_equal(factor, np.eye(len(source.inputs)))
+    with ThreadPoolExecutor(DRAW_THREADS) as pool:
+        for start in range(0, draws, step):
+            stop = min(start + step, draws)
+            scores = _scores(plan, start, stop, pool)
+            if correlated:  # (the identity factor would give the same numbers)
+                scores = factor @ scores
+            overrides = {x.path: x.from_scores(z, in_place=True) for x, z in zip(source.inputs, scores)}
+            ok, values = _run_chunk(source, overrides, rejected)
+            rows = np.flatnonzero(ok)
+            accepted += rows.size
+            # The accepted values, selected once: Stats keeps them (no copy) and
+            # so does the caller's table of draws while it has room.
+            chosen = {p: np.asarray(v, dtype=np.float64).take(rows) for p, v in values.items()}
+            for path, s in stats.items():
+                s.add(chosen[path], owned=True)
+            if kept_rows < KEEP:
+                kept_rows += rows.size
+                kept.append({**{p: v.take(rows) for p, v in overrides.items()}, **chosen})
+    return stats, accepted, rejected, kept
+
+
+def _scores(plan: SamplePlan, start: int, stop: int, pool: ThreadPoolExecutor) -> np.ndarray:
+    """Normal scores of draws start..stop-1 (start a multiple of BLOCK), one
+    row per input: each block from its own stream, blocks drawn on `pool`'s
+    threads (numpy releases the GIL while it fills an array; every block
+    writes its own columns, so the numbers do not depend on the threads)."""
+    out = np.empty((len(plan.dists), stop - start))
+
+    def block(a: int) -> None:
+        b = min(a + BLOCK, stop)
+        plan.draws_into(a, b, out[:, a - start : b - start])
+
+    list(pool.map(block, range(start, stop, BLOCK)))
+    return out
+
+
 def _run_chunk(source: Source, overrides: dict, rejected: dict):
     """Solve one chunk: (accepted mask, output path → values)."""
     columns, reason = source.columns(overrides)
@@ -198,12 +229,13 @@ def _run_chunk(source: Source, overrides: dict, rejected: dict):
         path: np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
         for path, v in source.command.outputs(columns, outs).items()
     }
-    ok = np.ones(n, dtype=bool)
-    reason = np.broadcast_to(np.asarray(reason, dtype=object), (n,))
-    bad_leaf = reason != ""
-    for text in np.unique(reason[bad_leaf]).tolist():
-        _count(rejected, text, int(np.count_nonzero(reason == text)))
-    ok &= ~bad_leaf
+    reason = np.asarray(reason)
+    bad_leaf = np.broadcast_to(reason != "", (n,))
+    ok = ~bad_leaf
+    if not ok.all():
+        reason = np.broadcast_to(reason, (n,))
+        for text in np.unique(reason[bad_leaf]).tolist():
+            _count(rejected, text, int(np.count_nonzero(reason == text)))
     for code in np.unique(status[ok & (status != 0)]).tolist():
         _count(rejected, STATUS_NAMES[int(code)].lower(), int(np.count_nonzero(ok & (status == code))))
     ok &= status == 0
@@ -399,32 +431,41 @@ def uncertainty(
     draws: int = 10_000,
     seed: int | None = None,
     sobol: bool = False,
-    restitution: float = 0.0,
+    restitution: float | None = None,
     energy: str | None = None,
     correction: str | None = None,
 ) -> Uncertainty:
     """Uncertainty of ``command``'s answers for a scene whose leaves carry
     distributions (see the module docstring and conventions.md, Uncertainty).
-    ``restitution``, ``energy``, ``correction``: CRASH3's options (crash3
-    only; the uncertainty of CRASH3 supports its default energy treatment,
-    dissipated, and the 1 + tan²α correction)."""
-    if energy not in (None, "dissipated") or correction not in (None, "crash3"):
-        raise ValueError(
-            "--uncertainty of crash3 supports energy 'dissipated' and correction "
-            f"'crash3' only, got energy {energy!r}, correction {correction!r}"
-        )
-    return propagate(scene_source(scene, command, restitution), draws=draws, seed=seed, sobol=sobol)
+    ``restitution``, ``energy`` ("dissipated" | "absorbed") and
+    ``correction`` ("crash3" | "woolley"): CRASH3's options (crash3 only),
+    overriding the scene's ``"crash3"`` object as in `impactsym.crash3`."""
+    return propagate(
+        scene_source(scene, command, restitution, energy, correction), draws=draws, seed=seed, sobol=sobol
+    )
 
 
-def scene_source(scene, command: str, restitution: float = 0.0) -> Source:
-    """The Source of a scene (path, mapping or Scene) for a command."""
-    from .scene import load_scene, scene_columns
+def scene_source(
+    scene,
+    command: str,
+    restitution: float | None = None,
+    energy: str | None = None,
+    correction: str | None = None,
+) -> Source:
+    """The Source of a scene (path, mapping or Scene) for a command; for
+    crash3 with the scene's CRASH3 options overridden by those given."""
+    from .crash3 import crash3_options
+    from .scene import load_scene, scene_columns, scene_data
 
     kind = {"solve": "forward", "invert": "inverse", "reconstruct": "reconstruct", "crash3": "crash3"}.get(
         command
     )
     if kind is None:
         raise ValueError(f"command: unknown command {command!r} (use one of {', '.join(COMMANDS)})")
+    options = {}
+    if command == "crash3":
+        opts = crash3_options(scene_data(scene), restitution, energy, correction)
+        options = {"restitution": opts.restitution, "energy": opts.energy, "correction": opts.correction}
     parsed = load_scene(scene, kind=kind)
     inputs = tuple(Input(path, kind_, tuple(params)) for path, kind_, params in parsed.uncertain)
 
@@ -433,7 +474,7 @@ def scene_source(scene, command: str, restitution: float = 0.0) -> Source:
         return sc.columns, sc.reason
 
     return Source(
-        command_for(command, parsed.model, parsed.units, restitution),
+        command_for(command, parsed.model, parsed.units, **options),
         inputs,
         columns,
         tuple(getattr(parsed, "correlations", ())),

@@ -161,15 +161,20 @@ def _split(result: Mapping):
 # --------------------------------------------------------------------------- CRASH3: a chain of kernels
 
 
-def _crash3_stages(c: Mapping, units: str, e: float, tangents: list | None = None):
-    """CRASH3 over columns `c` (scene_columns' crash3 form): per vehicle the
-    crush-energy kernel, radius of gyration and moment arm, then the delta-V
-    kernel on the total energy. With `tangents` (per input, d column) the
-    exact Jacobian kernels of each stage carry them through too (one scene).
-    Returns (values by name, status, per-input tangents by name)."""
-    from .crash3 import ENERGY_FACTOR
+def _crash3_stages(c: Mapping, options, units: str, tangents: list | None = None):
+    """CRASH3 over columns `c` (scene_columns' crash3 form) with `options`
+    (`impactsym.crash3.Crash3Options`: restitution, energy mode, oblique
+    correction): per vehicle the crush-energy kernel (its output for the
+    correction: E or E_woolley), radius of gyration and moment arm, then the
+    delta-V kernel of the energy mode (dissipated or absorbed) on the total
+    energy. With `tangents` (per input, d column) the exact Jacobian kernels
+    of each stage carry them through too (one scene). Returns (values by
+    name, status, per-input tangents by name)."""
+    from .crash3 import CORRECTED_OUTPUT, DELTA_V_KERNELS, ENERGY_FACTOR
 
     factor = ENERGY_FACTOR[units]
+    corrected = CORRECTED_OUTPUT[options.correction]
+    delta_v = DELTA_V_KERNELS[options.energy]
     n = max(
         [np.size(v) for k, v in c.items() if k != "crush"]
         + [np.size(v) for crush in c["crush"] if crush for v in crush.values()]
@@ -210,11 +215,11 @@ def _crash3_stages(c: Mapping, units: str, e: float, tangents: list | None = Non
         depths = sum(1 for k in crush if k.startswith("C") and k[1:].isdigit())
         inputs_key = {k: f"crush{i}.{k}" for k in crush}
         out = stage(f"crash3_energy_{depths}", _kernels.CRASH3_ENERGY[depths], crush, f"energy{i}.")
-        vals[f"E_crush{i}"], vals[f"E{i}"] = out["E_crush"] * factor, out["E"] * factor
+        vals[f"E_crush{i}"], vals[f"E{i}"] = out["E_crush"] * factor, out[corrected] * factor
         vals[f"alpha{i}"], vals[f"m{i}"] = crush["alpha"], c[f"m{i}"]
         if tan is not None:
             for t in tan:
-                t[f"E{i}"] = t[f"energy{i}.E"] * factor
+                t[f"E{i}"] = t[f"energy{i}.{corrected}"] * factor
                 t[f"E_crush{i}"] = t[f"energy{i}.E_crush"] * factor
                 t[f"alpha{i}"], t[f"m{i}"] = t.get(f"crush{i}.alpha", 0.0), t.get(f"m{i}", 0.0)
         if "radius_of_gyration" in crush:
@@ -253,11 +258,11 @@ def _crash3_stages(c: Mapping, units: str, e: float, tangents: list | None = Non
             t["E"] = t.get("E1", 0.0) + t.get("E2", 0.0)
     inputs_key = {k: k for k in ("m1", "m2", "rg1", "rg2", "h1", "h2", "E", "e", "gamma", "alpha1", "alpha2")}
     dv_inputs = {k: vals[k] if k in vals else c[k] for k in inputs_key if k != "e"}
-    dv_inputs["e"] = e
-    vals.update(stage("crash3_delta_v", _kernels.CRASH3_DELTA_V, dv_inputs, "dv."))
+    dv_inputs["e"] = options.restitution
+    vals.update(stage(delta_v.name, delta_v, dv_inputs, "dv."))
     if tan is not None:
         for t in tan:
-            for o in _kernels.CRASH3_DELTA_V.outputs:
+            for o in delta_v.outputs:
                 t[o] = t[f"dv.{o}"]
     return vals, status, tan
 
@@ -290,15 +295,16 @@ def _crash3_outputs(c: Mapping, v: Mapping) -> dict:
     return out
 
 
-def _crash3_command(units: str, e: float) -> Command:
-    """CRASH3 as a chain of kernels; its gradients chain their exact Jacobians."""
+def _crash3_command(units: str, options) -> Command:
+    """CRASH3 with `options` (restitution, energy mode, oblique correction) as
+    a chain of kernels; its gradients chain their exact Jacobians."""
 
     def run(c):
-        vals, status, _ = _crash3_stages(c, units, e)
+        vals, status, _ = _crash3_stages(c, options, units)
         return vals, status, np.zeros_like(status)
 
     def gradients(base: dict, dcols: list) -> dict:
-        vals, status, tan = _crash3_stages(base, units, e, dcols)
+        vals, status, tan = _crash3_stages(base, options, units, dcols)
         if status[0] != 0:
             return {}
         values = _crash3_outputs(base, {k: np.ravel(x)[0] if np.ndim(x) else x for k, x in vals.items()})
@@ -315,11 +321,22 @@ def _crash3_command(units: str, e: float) -> Command:
     return Command("crash3", run, lambda c: (None, {}), _crash3_outputs, gradients)
 
 
-def command_for(command: str, model: str = "rigid", units: str = "SI", restitution: float = 0.0) -> Command:
+def command_for(
+    command: str,
+    model: str = "rigid",
+    units: str = "SI",
+    restitution: float = 0.0,
+    energy: str = "dissipated",
+    correction: str = "crash3",
+) -> Command:
     """The Command of ``solve`` (any model), ``invert`` (rigid, particle),
-    ``reconstruct`` or ``crash3`` (scene units and CRASH3's restitution)."""
+    ``reconstruct`` or ``crash3`` (scene units and CRASH3's options: its
+    restitution, ``energy`` "dissipated" | "absorbed" and ``correction``
+    "crash3" | "woolley", as `impactsym.crash3`)."""
     if command == "crash3":
-        return _crash3_command(units, restitution)
+        from .crash3 import Crash3Options
+
+        return _crash3_command(units, Crash3Options(restitution, energy, correction))
     if command == "solve":
         return _forward_command(model)
     if command == "invert":

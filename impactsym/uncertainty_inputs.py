@@ -41,9 +41,14 @@ class Input:
         a, c, b = p
         return math.sqrt((a * a + b * b + c * c - a * b - a * c - b * c) / 18.0)
 
-    def from_scores(self, z: np.ndarray) -> np.ndarray:
-        """Values with normal scores `z` (inverse CDF of Φ(z))."""
+    def from_scores(self, z: np.ndarray, in_place: bool = False) -> np.ndarray:
+        """Values with normal scores `z` (inverse CDF of Φ(z)); `in_place`:
+        a normal input's values are written over `z` (the same numbers)."""
         if self.kind == "normal":
+            if in_place:
+                z *= self.params[1]
+                z += self.params[0]
+                return z
             return self.params[0] + self.params[1] * z
         return self.from_unit(_normal_cdf(z))
 

@@ -8,6 +8,8 @@ from typing import Any
 
 import numpy as np
 
+from ._quantiles import percentiles
+
 __all__ = ["Uncertainty", "Stats", "KEEP", "HISTOGRAM_BINS", "PERCENTILES"]
 
 #: Accepted draws kept for the caller (`Uncertainty.draws`); statistics use every draw.
@@ -34,16 +36,21 @@ class Stats:
         self.low_count = self.high_count = 0
         self.lo, self.hi = math.inf, -math.inf
 
-    def add(self, x: np.ndarray) -> None:
+    def add(self, x: np.ndarray, owned: bool = False) -> None:
+        """Add the values `x` (`owned`: the caller hands them over, they are
+        kept without a copy)."""
         if x.size == 0:
             return
         d = x - self.shift
         self.n += x.size
         self.s1 += float(d.sum())
-        self.s2 += float((d * d).sum())
-        self.lo, self.hi = min(self.lo, float(x.min())), max(self.hi, float(x.max()))
+        d *= d
+        self.s2 += float(d.sum())
+        low, high = float(x.min()), float(x.max())  # NaN if any value is NaN
+        self.lo = low if math.isnan(low) or low < self.lo else self.lo
+        self.hi = high if math.isnan(high) or high > self.hi else self.hi
         if self.hist is None and self.n <= KEEP:
-            self.kept.append(x.copy())
+            self.kept.append(x if owned else x.copy())
             self.kept_n = self.n
             return
         if self.hist is None:  # past KEEP: the histogram starts from the values kept
@@ -73,8 +80,8 @@ class Stats:
     def percentiles(self, q=PERCENTILES) -> list[float]:
         if self.n == 0:
             return [math.nan] * len(q)
-        if self.hist is None:
-            return [float(v) for v in np.percentile(np.concatenate(self.kept), q)]
+        if self.hist is None:  # exact: numpy.percentile's values, without sorting
+            return [float(v) for v in percentiles(self.kept, tuple(q), (self.lo, self.hi))]
         return [self._from_histogram(p) for p in q]
 
     def _from_histogram(self, p: float) -> float:
