@@ -914,19 +914,13 @@ class Target:
 
 def _angle_note(cases: dict) -> str:
     """What a per-row angle costs: rigid kernel (a) against (b), the same kernel with one
-    normal for the batch; and whether numba can vectorise cos/sin (SVML)."""
-    import numba
-
+    normal for the batch (median over rounds of the per-round difference)."""
     cost = per_round(cases["a"], cases["b"], "kernel", lambda p, q: p - q)
     return (
-        f"a per-row angle costs cos/sin on every row: {cost:.1f} ns/scene in the rigid "
-        f"kernel ((a) {cases['a'].median_ns('kernel'):.1f} against (b), one normal, "
+        f"a per-row angle costs reading it and the vectorised sincos (derive/trig.py) on "
+        f"every row: {cost:.1f} ns/scene in the rigid kernel (per-round median; medians "
+        f"(a) {cases['a'].median_ns('kernel'):.1f} against (b), one normal, "
         f"{cases['b'].median_ns('kernel'):.1f})"
-        + (
-            ""
-            if numba.config.USING_SVML
-            else "; numba has no SVML here (intel-cmplr-lib-rt), so cos/sin stay scalar calls"
-        )
     )
 
 
