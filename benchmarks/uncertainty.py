@@ -155,11 +155,11 @@ def jacobian_vs_value(rows: int = 200_000) -> dict:
     cols["v1x"] = 20 + rng.standard_normal(rows)
     jac, val = _kernels.JACOBIAN["particle"], _kernels.KERNELS[("particle", False, False, "energy")]
     start = time.perf_counter()
-    batch.run_columns(jac, cols, jac.outputs)
+    batch.run_columns(jac, cols, jac.outputs, "the particle Jacobian")
     compile_s = time.perf_counter() - start
-    batch.run_columns(val, cols, val.outputs)
-    t_jac = _best(lambda: batch.run_columns(jac, cols, jac.outputs))
-    t_val = _best(lambda: batch.run_columns(val, cols, val.outputs))
+    batch.run_columns(val, cols, val.outputs, "the particle model")
+    t_jac = _best(lambda: batch.run_columns(jac, cols, jac.outputs, "the particle Jacobian"))
+    t_val = _best(lambda: batch.run_columns(val, cols, val.outputs, "the particle model"))
     out["particle batch (numba, parallel)"] = {
         "rows": rows,
         "jacobian_s": t_jac,
