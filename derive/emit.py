@@ -473,17 +473,36 @@ def driver_function(kernel: Kernel, parallel: bool, normal: bool, style: Style =
     lines += _wrap(
         f"def {driver_name(kernel, parallel, normal)}(", [f"c_{c}" for c in columns] + outs, "):", " " * 8
     )
+    loop = f"for i in {'prange' if parallel else 'range'}(out_status.shape[0]):"
+    if not normal:
+        doc = f'    """{"Parallel" if parallel else "Serial"} batch of `{kernel.name}`{", the angle per row" if angle else ""}."""'
+        head = [f"    {loop}"] + ([f"{ind}ny, nx = _sincos(c_{kernel.angle}[i])"] if angle else [])
+        return "\n".join([*lines, doc, *head, *_row(kernel, args, outs, ind, angle)]) + "\n"
+    # One normal for the batch comes as length-1 arrays, read once before the
+    # loop: no filled (nx, ny) columns to write and read again (the one
+    # cos/sin per batch path); per-row normals (angles beyond SINCOS_LIMIT)
+    # take the second loop.
     lines += [
-        f'    """{"Parallel" if parallel else "Serial"} batch of `{kernel.name}`'
-        f'{", the angle per row" if angle else ""}."""',
-        f"    for i in {'prange' if parallel else 'range'}(out_status.shape[0]):",
+        f'    """{"Parallel" if parallel else "Serial"} batch of `{kernel.name}`, the normal '
+        'given: one (nx, ny) for every row as length-1 arrays, or one per row."""',
+        "    if c_nx.shape[0] == 1:",
+        "        nx, ny = c_nx[0], c_ny[0]",
+        f"        {loop}",
+        *_row(kernel, args, outs, ind + "    ", True),
+        "    else:",
+        f"        {loop}",
+        *_row(kernel, args, outs, ind + "    ", False),
     ]
-    if angle:
-        lines.append(f"{ind}ny, nx = _sincos(c_{kernel.angle}[i])")
-    values = [a if angle and a in ("nx", "ny") else f"c_{a}[i]" for a in args]
-    lines += _wrap(f"{ind}(", [f"{o}[i]" for o in outs], ") = (", ind + "    ")
-    lines += _wrap(f"{ind}    _{kernel.name}_body(", values, "))", ind + "    ")
     return "\n".join(lines) + "\n"
+
+
+def _row(kernel: Kernel, args: list, outs: list, ind: str, local_normal: bool) -> list:
+    """One row of a driver: the outputs at i from the body of the inputs at i
+    (nx, ny as locals when `local_normal`)."""
+    values = [a if local_normal and a in ("nx", "ny") else f"c_{a}[i]" for a in args]
+    return _wrap(f"{ind}(", [f"{o}[i]" for o in outs], ") = (", ind + "    ") + _wrap(
+        f"{ind}    _{kernel.name}_body(", values, "))", ind + "    "
+    )
 
 
 def render_jit_module(model_file: str, kernels, digest: str, style: Style = DEFAULT) -> str:

@@ -338,14 +338,16 @@ def _as_input(value):
 def _columns_for(ks: KernelSet, inputs: list, n: int) -> tuple[list, bool]:
     """The driver's columns (scalars still scalars) and whether the normal
     form runs. One angle for every row: its normal once (`unit_normal`), not
-    per row. Per-row angles within SINCOS_LIMIT: the angle driver (`_sincos`
-    per row). Otherwise NumPy's cos/sin give the normal for the batch."""
+    per row, as length-1 arrays that the normal driver reads once. Per-row
+    angles within SINCOS_LIMIT: the angle driver (`_sincos` per row).
+    Otherwise NumPy's cos/sin give the normal of each row."""
     if ks.angle is None:
         return inputs, False
     at = ks.inputs.index(ks.angle)
     angle = inputs[at]
     if not isinstance(angle, np.ndarray):
-        return inputs[:at] + list(ks.unit_normal(angle)) + inputs[at + 1 :], True
+        normal = [np.array([component]) for component in ks.unit_normal(angle)]
+        return inputs[:at] + normal + inputs[at + 1 :], True
     limit = _generated(ks.model).SINCOS_LIMIT
     if np.any(np.isfinite(angle) & (np.abs(angle) > limit)):
         with np.errstate(invalid="ignore"):
@@ -382,12 +384,21 @@ def _call(ks: KernelSet, driver, parallel: bool, columns: list, outs: list) -> N
         fills = _fills(columns, size, scalars)
         for start in range(0, n, size):
             stop = min(start + size, n)
-            args = [c[start:stop] if f is None else f[: stop - start] for c, f in zip(columns, fills)]
+            args = [
+                _rows_of(c, start, stop, n) if f is None else f[: stop - start]
+                for c, f in zip(columns, fills)
+            ]
             driver(*args, *(o[start:stop] for o in outs))
     finally:
         if timer is not None:
             timer.cancel()
     _after_first_batch()
+
+
+def _rows_of(column: np.ndarray, start: int, stop: int, n: int) -> np.ndarray:
+    """Rows start..stop-1 of an array column; a length-1 array in an n-row
+    batch (one normal for every row) is passed whole."""
+    return column if column.shape[0] == 1 < n else column[start:stop]
 
 
 def _fills(columns: list, size: int, scalars: int) -> list:
