@@ -28,6 +28,11 @@ MODEL_MODULES = (
 )
 # Proved before emission but emitting no module of their own (emit inlines their source).
 PROOF_ONLY_MODULES = ("trig",)
+# Emitted without numba batch drivers: the linear method evaluates a Jacobian
+# once per scene with the plain-Python function, and a driver returning the
+# 100-300 outputs of a Jacobian does not compile (numba has no LIST_TO_TUPLE,
+# which CPython uses for tuples of more than 30 values).
+PER_SCENE_ONLY_MODULES = ("jacobian",)
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -51,10 +56,12 @@ def render_all() -> dict[str, str]:
         mod = importlib.import_module(f"derive.{name}")
         doc = (mod.__doc__ or "").strip().splitlines()[0]
         kernels = getattr(mod, "EMITTED", mod.KERNELS)
+        drivers = name not in PER_SCENE_ONLY_MODULES
         files[f"{name}.py"] = emit.render_module(
-            f"{name}.py", doc, kernels, digest, data=getattr(mod, "DATA", ())
+            f"{name}.py", doc, kernels, digest, data=getattr(mod, "DATA", ()), drivers=drivers
         )
-        files[f"{name}_jit.py"] = emit.render_jit_module(f"{name}.py", kernels, digest)
+        if drivers:
+            files[f"{name}_jit.py"] = emit.render_jit_module(f"{name}.py", kernels, digest)
     files["codes.py"] = emit.render_codes(digest)
     files["__init__.py"] = emit.render_init(MODEL_MODULES, digest)
     return files

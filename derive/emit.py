@@ -397,17 +397,20 @@ def _legend(kernels) -> list[str]:
     return lines
 
 
-def render_module(model_file: str, doc: str, kernels, digest: str, data=()) -> str:
+def render_module(model_file: str, doc: str, kernels, digest: str, data=(), drivers: bool = True) -> str:
     """generated/<model>.py as text: header, MANIFEST, data tables, per-scene
     functions. `data` holds (NAME, value) pairs of plain Python literals
-    (numbers, strings, tuples, dicts): tables a model module derives."""
+    (numbers, strings, tuples, dicts): tables a model module derives.
+    `drivers`: whether generated/<model>_jit.py holds its batch drivers."""
     progs = [program(k) for k in kernels]
     model = model_file.removesuffix(".py")
     total = sum(p.operations for p in progs)
     parts = [
         header(model_file, digest).rstrip("\n"),
         f"# {len(progs)} kernels, {total} arithmetic operations after common-subexpression elimination;",
-        f"# batch drivers: generated/{model}_jit.py.",
+        f"# batch drivers: generated/{model}_jit.py."
+        if drivers
+        else "# no batch drivers: evaluated per scene.",
         *_legend(kernels),
         "",
         f'"""{doc}"""',
