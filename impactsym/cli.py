@@ -497,18 +497,21 @@ def _add_compile(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_compile(args: argparse.Namespace) -> int:
-    """Compile every batch driver once for this machine (impactsym.warmup)."""
+    """Compile every batch driver once for this machine (impactsym.warmup),
+    and the loops of exact percentiles."""
+    from . import _selection  # imports numba: only this command needs it
+
     where, digest = _kernels.generated.__file__, _kernels.generated_digest()
     start = time.perf_counter()
     try:
-        count = _kernels.compile_all(None if args.quiet else print)
+        count = _kernels.compile_all(None if args.quiet else print) + _selection.compile_loops()
     except BaseException:
         warmup.release(where, digest)
         raise
     warmup.finish(where, digest)
     if not args.quiet:
         print(
-            f"compiled or loaded {count} batch drivers in {time.perf_counter() - start:.0f} s; "
+            f"compiled or loaded {count} batch drivers and loops in {time.perf_counter() - start:.0f} s; "
             f"cache: {warmup.cache_dir(where)}"
         )
     return 0
