@@ -3,7 +3,9 @@
 Only this module imports `generated`. A single scene runs the kernel's
 per-scene function from the plain module ``generated/<model>.py`` (no numba
 import, nothing compiles). Batches run the numba drivers of
-``generated/<model>_jit.py``, imported on the first batch call: the serial one
+``generated/<model>_jit.py``, imported on the first batch call of at least
+`PYTHON_BELOW` rows (a smaller batch before that runs the per-scene function
+row by row: the same bits, without waiting for numba to load): the serial one
 below `SERIAL_BELOW` rows (a `prange` launch costs more than it saves), the
 parallel one above. Every driver argument is a C-contiguous float64 array, so
 each driver compiles once per machine (numba's on-disk cache) whatever mix of
@@ -14,6 +16,7 @@ array, reused chunk after chunk (`FILL_BYTES`).
 from __future__ import annotations
 
 import importlib
+import itertools
 import math
 import os
 import sys
@@ -58,6 +61,20 @@ STATUS_PDOF_BEYOND_LIMIT = CODES.STATUS_PDOF_BEYOND_LIMIT
 FLAG_PDOF_CAPPED = CODES.FLAG_PDOF_CAPPED
 
 SERIAL_BELOW = 64
+
+# A process's first PYTHON_BELOW rows of batches run through the kernels'
+# per-scene functions (plain Python, row by row) while the model's numba
+# drivers are not loaded: importing numba and loading the drivers from its
+# cache takes 0.5-1 s, the per-scene function 3-30 us a row, so a small first
+# batch (a sweep of a few hundred points, a sample of a few thousand draws)
+# returns without that wait. The budget is per process, not per call: once
+# the rows run in Python would have paid for the load, the drivers load (a
+# loop of small batches is not left in Python). The results are the same
+# bits: the per-scene function and the drivers evaluate the same emitted
+# expressions in the same order with IEEE semantics (numba without fast-math);
+# tests/test_python_rows.py checks it for every kernel.
+PYTHON_BELOW = 10_000
+_python_rows = 0  # rows this process has run through the per-scene functions
 
 OUTPUTS = (
     "V1x",
@@ -395,6 +412,45 @@ def _call(ks: KernelSet, driver, parallel: bool, columns: list, outs: list) -> N
     _after_first_batch()
 
 
+def _in_python(ks: KernelSet, n: int) -> bool:
+    """Whether a batch of `n` rows runs the per-scene function (`PYTHON_BELOW`);
+    if so, its rows are counted against the process's budget."""
+    global _python_rows
+    if ks.model in _JIT_MODULES or _python_rows + n >= PYTHON_BELOW:
+        return False
+    _python_rows += n
+    return True
+
+
+def _run_rows(ks: KernelSet, columns: list, normal: bool, outs: dict, status, flags) -> bool:
+    """Fill `outs`, `status` and `flags` row by row with the per-scene function
+    (no numba); `columns` as `_columns_for` gives them. False, with nothing
+    promised about the outputs, when a row raises (Python's float arithmetic
+    raises where numba's returns inf or NaN, e.g. math.sqrt of a negative
+    number): then the drivers run the batch."""
+    n = status.shape[0]
+    rows = [_values_of(c, n) for c in columns]
+    if ks.angle is not None and not normal:
+        at = ks.inputs.index(ks.angle)
+        nx, ny = zip(*map(ks.unit_normal, rows[at]))
+        rows[at : at + 1] = [nx, ny]
+    try:
+        results = list(map(ks.scene, *rows))
+    except (ArithmeticError, ValueError):
+        return False
+    for target, values in zip((*outs.values(), status, flags), zip(*results)):
+        target[:] = values
+    return True
+
+
+def _values_of(column, n: int):
+    """A driver column as n Python floats: an array of the batch's length as a
+    list, a scalar or a length-1 array (one normal for every row) repeated."""
+    if isinstance(column, np.ndarray) and column.shape[0] == n:
+        return column.tolist()
+    return itertools.repeat(float(column[0] if isinstance(column, np.ndarray) else column), n)
+
+
 def _rows_of(column: np.ndarray, start: int, stop: int, n: int) -> np.ndarray:
     """Rows start..stop-1 of an array column; a length-1 array in an n-row
     batch (one normal for every row) is passed whole."""
@@ -498,6 +554,9 @@ def run_batch(ks: KernelSet, inputs: list, n: int | None = None) -> tuple[dict, 
     if n == 0:
         return outs, status, flags
     columns, normal = _columns_for(ks, inputs, n)
+    if _in_python(ks, n) and _run_rows(ks, columns, normal, outs, status, flags):
+        _after_first_batch()
+        return outs, status, flags
     parallel = n >= SERIAL_BELOW
     _call(ks, ks.driver(parallel, normal), parallel, columns, [*outs.values(), status, flags])
     return outs, status, flags

@@ -172,7 +172,8 @@ def test_a_read_only_install_caches_compiled_drivers_in_the_user_directory(tmp_p
     code = (
         "import os; real = os.access; "
         "os.access = lambda p, m, **k: False if m == os.W_OK else real(p, m, **k); "
-        "import impactsym; "
+        "import impactsym; from impactsym import _kernels; "
+        "_kernels.PYTHON_BELOW = 0; "  # a one-row batch runs the driver, not the per-scene function
         "out = impactsym.solve_batch({'m1': [1500.0], 'm2': [1200.0], 'v1x': [20.0], "
         "'v1y': [0.0], 'v2x': [0.0], 'v2y': [0.0], 'gamma': 0.0, 'e': 0.2, 'mu': 0.1}, "
         "model='particle'); "
