@@ -133,9 +133,13 @@ def test_every_block_names_the_equation_it_implements():
 
 
 def test_generated_files_carry_the_header():
+    """Every committed file of generated/ (that they are exactly what derive renders
+    is the slow test_check_passes_on_the_committed_files)."""
     digest = emit.source_hash()
-    for name in derive_main.render_all():
-        head = (ROOT / "generated" / name).read_text().splitlines()[:3]
+    files = sorted((ROOT / "generated").glob("*.py"))
+    assert len(files) >= 10
+    for path in files:
+        head = path.read_text().splitlines()[:3]
         assert "DO NOT EDIT" in head[0]
         assert "python -m derive" in head[1]
         assert f"SymPy {sp.__version__}" in head[2] and digest in head[2]

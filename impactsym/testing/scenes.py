@@ -11,6 +11,8 @@ Angles are in radians; ``n = (cos gamma, sin gamma)`` points from vehicle 1 to 2
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from . import reference
@@ -163,8 +165,15 @@ def random_realistic(n: int, seed: int, model: str = "rigid", barrier: bool = Fa
     speed. ``mu`` is a random fraction in [0, 1) of the row's critical impulse ratio
     mu_c (so it has mu_c's sign; 10 % of rows have mu = 0). Nearly singular rows are
     dropped (MAX_VELOCITY_CHANGE). Deterministic in ``seed``; costs two 50-digit
-    solves per row.
+    solves per row (~5 s for 400 rows), so each argument set is drawn once per
+    process and returned as fresh copies (a caller may change them in place).
     """
+    return {key: value.copy() for key, value in _random_realistic(n, seed, model, barrier).items()}
+
+
+@functools.lru_cache(maxsize=64)
+def _random_realistic(n: int, seed: int, model: str, barrier: bool) -> dict:
+    """The draw behind ``random_realistic``, memoised."""
     if model not in ("rigid", "particle"):
         raise ValueError(f"unknown model {model!r}")
     rng = np.random.default_rng(seed)
