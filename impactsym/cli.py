@@ -639,13 +639,23 @@ def _raise_interrupted(signum, frame):
         raise KeyboardInterrupt
 
 
+# Python functions that C code calls through ctypes while numba loads or
+# compiles a driver: llvmlite's object-cache hooks (ExecutionEngine). Python
+# prints and drops an exception raised in a ctypes callback, as in a finaliser.
+_CTYPES_CALLBACKS = ("_raw_object_cache_notify", "_raw_object_cache_getbuffer")
+
+
 def _deferred(signum, frame) -> bool:
-    """True when the signal landed inside a finaliser (``__del__``; numba and
-    llvmlite free compiler objects there), where Python prints and drops an
-    exception, so Ctrl-C would be lost: the signal is sent again 50 ms later,
-    when the finaliser has returned."""
+    """True when the signal landed where Python prints and drops an exception,
+    so Ctrl-C would be lost: inside a finaliser (``__del__``; numba and llvmlite
+    free compiler objects there) or a ctypes callback (`_CTYPES_CALLBACKS`,
+    reached while numba loads a driver from its cache). The signal is sent
+    again 50 ms later, when that code has returned."""
     while frame is not None:
-        if frame.f_code.co_name == "__del__":
+        code = frame.f_code
+        if code.co_name == "__del__" or (
+            code.co_name in _CTYPES_CALLBACKS and "llvmlite" in code.co_filename
+        ):
             threading.Timer(0.05, os.kill, (os.getpid(), signum)).start()
             return True
         frame = frame.f_back

@@ -506,6 +506,44 @@ def test_an_interrupted_sweep_leaves_no_spill_file_and_no_traceback(tmp_path, si
     assert list(temp.iterdir()) == []
 
 
+def test_a_signal_inside_llvmlites_object_cache_hook_is_sent_again_not_lost():
+    # A Ctrl-C landing in llvmlite's object-cache hook, a ctypes callback that
+    # runs while numba loads a driver from its cache, was printed ("Exception
+    # ignored on calling ctypes callback function") and dropped: the sweep ran
+    # on and exited 0 (seen sending SIGINT 0.3 s after a sweep's first spill).
+    # Here the real hook is called through its real ctypes wrapper, and the
+    # handler's test runs inside it (from a profile hook).
+    from llvmlite.binding import executionengine
+
+    from impactsym import cli
+
+    class Engine:
+        _object_cache_notify = None  # the hook returns at once
+
+    hook = executionengine.ExecutionEngine._raw_object_cache_notify.__code__
+    inside = []
+
+    def profiler(frame, event, arg):
+        if event == "call" and frame.f_code is hook:
+            inside.append(cli._deferred(signal.SIGUSR1, frame))
+
+    received = []
+    previous = signal.signal(signal.SIGUSR1, lambda signum, frame: received.append(signum))
+    try:
+        sys.setprofile(profiler)
+        try:
+            executionengine._notify_c_hook(Engine(), None)
+        finally:
+            sys.setprofile(None)
+        assert inside == [True]
+        deadline = time.monotonic() + 5
+        while not received and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert received == [signal.SIGUSR1]
+    finally:
+        signal.signal(signal.SIGUSR1, previous)
+
+
 def test_a_signal_inside_a_finaliser_is_sent_again_not_lost():
     # Python drops an exception raised in __del__ (numba and llvmlite free compiler
     # objects there), so a Ctrl-C landing there would be lost: the CLI's handler
