@@ -91,7 +91,7 @@ def approach_guard() -> Guard:
 ROUNDING = sp.Rational(1, 2**48)
 
 
-def physics_flags(energy_parts, work_terms, mu_used=mu_used):
+def physics_flags(energy_parts, work_terms, mu_used=mu_used, restitution=None):
     """The block of flag tolerances and the conditions for the flag bits of
     conventions.md on a solved row.
 
@@ -99,7 +99,9 @@ def physics_flags(energy_parts, work_terms, mu_used=mu_used):
     sum of |work terms| (|Pn·gn| + |Pt·gt| (+ |M·wr|)) the parts are built from.
     Tensile normal impulse: Pn ≥ 0 (a compressive impulse on vehicle 1 points
     along -n). μ beyond critical: μ not between 0 and μ_c (either sign), by
-    more than ROUNDING·|μ_c|.
+    more than ROUNDING·|μ_c|. With `restitution` (a kernel that takes e):
+    e outside [0, 1], which the equations solve but no collision has (e < 0
+    leaves the vehicles moving into each other, e > 1 creates energy).
     """
     tolerances = Block(
         (
@@ -118,6 +120,10 @@ def physics_flags(energy_parts, work_terms, mu_used=mu_used):
                 sp.StrictGreaterThan(mu_used, sp.Max(0, mu_c) + tol_mu),
             ),
         ),
+    ) + (
+        (("E_OUT_OF_RANGE", (sp.StrictLessThan(restitution, 0), sp.StrictGreaterThan(restitution, 1))),)
+        if restitution is not None
+        else ()
     )
 
 

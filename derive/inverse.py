@@ -249,7 +249,7 @@ def _kernel(rigid: bool) -> Kernel:
         scalars = (V1x, V1y, V2x, V2y, gamma, e, mu)
         masses = (m1, m2)
         energy, work = (TL, TLn, TLt), ((Pn, gn), (Pt, gt))
-    tolerances, flags = f.physics_flags(energy, work, mu_used=mu)
+    tolerances, flags = f.physics_flags(energy, work, mu_used=mu, restitution=e)
     return Kernel(
         name=name,
         doc=(

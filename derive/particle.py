@@ -178,7 +178,7 @@ def kernel(sticking: bool) -> Kernel:
         if sticking
         else "impulse ratio mu given (seed eqs 10-13)."
     )
-    tolerances, flags = f.physics_flags((TL, TLn, TLt), ((Pn, gn), (Pt, gt)))
+    tolerances, flags = f.physics_flags((TL, TLn, TLt), ((Pn, gn), (Pt, gt)), restitution=e)
     return Kernel(
         name=name,
         doc=doc,

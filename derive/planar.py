@@ -377,7 +377,7 @@ def kernel(sticking: bool) -> Kernel:
         "no sliding at separation (mu = mu_c)." if sticking else "impulse ratio mu given."
     )
     scalars = (v1x, v1y, w1, v2x, v2y, w2, r1x, r1y, r2x, r2y, gamma, e, e_m)
-    tolerances, flags = f.physics_flags((TL, TLn, TLt, TLm), ((Pn, gn), (Pt, gt), (M, wr)))
+    tolerances, flags = f.physics_flags((TL, TLn, TLt, TLm), ((Pn, gn), (Pt, gt), (M, wr)), restitution=e)
     return Kernel(
         name=name,
         doc=doc,

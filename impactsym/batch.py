@@ -10,7 +10,7 @@ strict as a scene file: missing, of another length, unknown (with the nearest
 name, ``restitusion: unknown column; did you mean "e" (restitution)?``), not
 read by the model (``I1`` for particles), or not numbers (bool, text, None, a
 structured array). A forward or inverse row whose given restitution e is
-outside [0, 1] is solved (as a scene is, with a warning) and marked with the
+outside [0, 1] is solved (as a scene is) and the kernel marks it with the
 flag `codes.FLAG_E_OUT_OF_RANGE`.
 
 Dispatch is per whole array, never per row in Python: the rows of a batch are
@@ -30,7 +30,6 @@ import numpy as np
 from . import _kernels
 from ._util import CHUNK_SIZE, is_dataframe, row_count, spans
 from .casefile import unknown_key
-from .codes import FLAG_E_OUT_OF_RANGE
 from .dask_engine import map_chunks
 from .scene import CRITICAL
 
@@ -146,32 +145,16 @@ def _run(ks: _kernels.KernelSet, columns, outputs, placeholders) -> dict:
     n = row_count(columns, names)
     inputs = [0.0 if name in placeholders else _as_column(columns, name) for name in ks.inputs]
     outs, status, flags = _kernels.run_batch(ks, inputs, n)
-    if "e" in names:
-        _flag_restitution(inputs[ks.inputs.index("e")], status, flags)
     return _collect(ks, outs, status, flags, outputs, n)
-
-
-def _flag_restitution(e, status: np.ndarray, flags: np.ndarray) -> None:
-    """Mark the solved rows whose given restitution is outside [0, 1] with
-    FLAG_E_OUT_OF_RANGE (in place): e < 0 leaves the vehicles moving into
-    each other after the impact, e > 1 creates normal energy. The kernel
-    solves them (its equations hold for any e) and the scene path warns; a
-    batch row has no warnings, so it carries the flag. NaN e is status 1."""
-    e = np.asarray(e).ravel()
-    # Two reductions without temporaries first: almost every batch has no such
-    # row, and the mask (three passes over the rows) is built only when one is
-    # there. fmin/fmax skip NaN (np.min would return NaN and hide the others).
-    if not (np.fmin.reduce(e, initial=0.0) < 0.0 or np.fmax.reduce(e, initial=1.0) > 1.0):
-        return
-    outside = (e < 0.0) | (e > 1.0)
-    flags |= np.where(outside & (status == 0), FLAG_E_OUT_OF_RANGE, 0).astype(flags.dtype)
 
 
 def _collect(ks, outs, status, flags, outputs, n) -> dict:
     """The requested outputs of a kernel run: computed, constant (e_m = 1:
     M = 0) or absent from the model (particles: yaw, M) → the constant or 0,
     NaN on rows that were not solved."""
-    failed = (status != 0) if status.any() else None  # the mask only when a row failed
+    filled = [name for name in outputs if name not in outs]
+    # The mask only when a quantity is filled in and a row failed.
+    failed = (status != 0) if filled and status.any() else None
     result = {
         name: outs[name] if name in outs else _filler(failed, n, ks.constants.get(name, 0.0))
         for name in outputs
@@ -326,8 +309,9 @@ def _no_moment(columns) -> bool:
     em = np.asarray(columns["e_m"])
     if em.dtype.kind not in "fiu":
         return False
-    # The first row decides most batches without a pass over the column.
-    return bool(em.flat[0] == 1.0) and bool(np.all(em == 1.0)) if em.size else True
+    # The first row decides most batches without a pass over the column; then
+    # two reductions without temporaries (a NaN makes min and max NaN: not 1).
+    return bool(em.flat[0] == 1.0 and em.min() == 1.0 and em.max() == 1.0) if em.size else True
 
 
 def _solve_mixed(columns, models, critical, names, tier: str) -> dict:

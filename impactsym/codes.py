@@ -38,8 +38,8 @@ flag   meaning (bits add up)
        points along -n)
 4      impulse ratio beyond critical: mu not between 0 and mu_c
 8      restitution e is outside [0, 1]: (reconstruction) the implied e; (forward and
-       inverse batches) the given e, marked by impactsym.batch on a solved row (a
-       single scene warns instead, impactsym.result.scene_warnings)
+       inverse kernels, a scene or a batch) the given e, on a solved row (a scene
+       also warns, impactsym.result.scene_warnings)
 16     (reconstruction) a speed is negative: the vehicle moved against its heading
 32     (reconstruction) the headings are within about 6° of collinear
        (|sin(θ1 - θ2)| < 0.1): the speeds are sensitive to the headings
@@ -100,7 +100,7 @@ FLAG_MESSAGES = {
     "the friction impulse would reverse the sliding (seed Table 2)",
     FLAG_E_OUT_OF_RANGE: "restitution e is outside [0, 1], which is not physical (a "
     "reconstruction's implied e: the post-impact motion, headings or impact centre are "
-    "inconsistent; a batch row's given e: e < 0 leaves the vehicles moving into each other, "
+    "inconsistent; a given e: e < 0 leaves the vehicles moving into each other, "
     "e > 1 creates energy)",
     FLAG_NEGATIVE_SPEED: "a reconstructed speed is negative: the vehicle would have moved "
     "against its stated heading",

@@ -189,3 +189,21 @@ def test_a_read_only_install_caches_compiled_drivers_in_the_user_directory(tmp_p
     cache = tmp_path / "impactsym" / "numba"
     assert proc.stdout.strip() == str(cache)
     assert any(cache.rglob("*.nbi")), "nothing cached in the user directory"
+
+
+@pytest.mark.parametrize(
+    "angles, beyond",
+    [
+        ([0.1, -3.0, 2.0], False),
+        ([10.0, -10.0], False),  # at the limit: the angle driver still serves it
+        ([np.nan, 11.0], True),  # NaN does not hide an angle beyond the limit
+        ([-11.0, np.nan, 0.0], True),
+        ([np.inf, -np.inf, 1.0], False),  # ±inf is a bad row (status 1), not beyond
+        ([np.inf, np.nan, -12.0], True),
+        ([np.nan, np.nan], False),
+    ],
+)
+def test_angles_beyond_the_sincos_limit_are_found_past_nan_and_inf(angles, beyond):
+    from impactsym._kernels import _beyond
+
+    assert _beyond(np.array(angles), 10.0) is beyond

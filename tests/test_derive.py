@@ -201,3 +201,31 @@ def test_per_scene_functions_never_raise(module):
         for _ in range(3000):
             args = [rng.choice(values) for _ in row["arguments"]]
             assert len(function(*args)) == len(row["outputs"]) + 2, (name, args)
+
+
+@pytest.mark.parametrize("count", [2, 3, 7, 17, 19])
+def test_the_emitted_finiteness_test_is_every_isfinite(count):
+    """`all_finite` (one comparison of a tree of x*0.0) is true exactly when
+    every value is finite, in Python and compiled by numba, on values that a
+    sum would overflow (±max double), subnormals, signed zeros, ±inf, NaN."""
+    import math
+    import random
+
+    import numba
+
+    names = [f"x{k}" for k in range(count)]
+    test = eval(f"lambda {', '.join(names)}: {emit.all_finite(names)}")
+    compiled = numba.njit(error_model="numpy")(test)
+    specials = [0.0, -0.0, 1.0, -2.5, 5e-324, 1.7976931348623157e308, -1.7976931348623157e308]
+    specials += [math.inf, -math.inf, math.nan]
+    rng = random.Random(count)
+    rows = [[1.7976931348623157e308] * count]
+    for _ in range(400):
+        row = [rng.choice(specials[:7]) for _ in range(count)]
+        if rng.random() < 0.6:
+            row[rng.randrange(count)] = rng.choice(specials[7:])
+        rows.append(row)
+    assert {all(map(math.isfinite, row)) for row in rows} == {True, False}
+    for row in rows:
+        want = all(math.isfinite(x) for x in row)
+        assert test(*row) is want and compiled(*row) == want, row

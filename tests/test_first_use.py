@@ -197,9 +197,14 @@ def test_restitution_outside_0_1_is_solved_and_flagged_as_the_scene_warns():
     assert list(out["status"]) == [0] * 5
     marked = (out["flags"] & FLAG_E_OUT_OF_RANGE) != 0
     assert list(marked) == [True, False, False, False, True]
-    # The scene path solves the same scene and warns.
+    # The scene path solves the same scene, carries the same flag (the kernel
+    # sets it) and warns about the input.
     scene = {**SCENE, "impact": {**SCENE["impact"], "restitution": -0.3}}
-    assert any("restitution = -0.3 is outside [0, 1]" in w for w in impactsym.solve(scene).warnings)
+    result = impactsym.solve(scene)
+    assert result.flags & FLAG_E_OUT_OF_RANGE
+    assert any("restitution = -0.3 is outside [0, 1]" in w for w in result.warnings)
+    inside = impactsym.solve({**SCENE, "impact": {**SCENE["impact"], "restitution": 0.3}})
+    assert not inside.flags & FLAG_E_OUT_OF_RANGE
 
 
 def test_every_batch_docstring_says_angles_are_radians():
