@@ -18,6 +18,7 @@ os.environ["IMPACTSYM_BACKGROUND_COMPILE"] = "0"
 
 SUBCOMMANDS = {
     "accuracy": "benchmarks.accuracy",
+    "body": "benchmarks.body",
     "inverse": "benchmarks.inverse",
     "performance": "benchmarks.performance",
     "uncertainty": "benchmarks.uncertainty",
