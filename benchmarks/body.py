@@ -44,8 +44,7 @@ def add_arguments(parser) -> None:
 def _case_runner(case, rows: int):
     """A zero-argument call of a case's parallel driver on preallocated outputs."""
     ks = _kernels.kernel_for(*case.kernel)
-    unread = ("mu",) if case.kernel[1] else ()
-    inputs = [_kernels._as_input(0.0 if k in unread else case.columns[k]) for k in ks.inputs]
+    inputs = [_kernels._as_input(x) for x in case.inputs()]
     columns, normal = _kernels._columns_for(ks, inputs, rows)
     columns = [c if isinstance(c, np.ndarray) else np.full(rows, c) for c in columns]
     outs = [np.empty(rows) for _ in ks.outputs] + [np.empty(rows, np.int32), np.empty(rows, np.int32)]

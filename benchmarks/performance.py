@@ -274,11 +274,15 @@ class Case:
     def real(self) -> Callable[[], dict]:
         return lambda: impactsym.solve_batch(self.columns, **self.kwargs)
 
+    def inputs(self) -> list:
+        """The kernel's inputs in its order (critical: mu is a placeholder 0)."""
+        ks = _kernels.kernel_for(*self.kernel)
+        unread = ("mu",) if self.kernel[1] else ()
+        return [0.0 if k in unread else self.columns[k] for k in ks.inputs]
+
     def kernel_only(self) -> Callable[[], tuple]:
         """The kernel through the runtime: run_batch (allocation + driver), no solve_batch layer."""
-        ks = _kernels.kernel_for(*self.kernel)
-        unread = ("mu",) if self.kernel[1] else ()  # critical: mu is a placeholder
-        inputs = [0.0 if k in unread else self.columns[k] for k in ks.inputs]
+        ks, inputs = _kernels.kernel_for(*self.kernel), self.inputs()
         n = self.columns["m1"].shape[0]
         return lambda: _kernels.run_batch(ks, inputs, n)
 
