@@ -8,13 +8,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import os
 import sys
-
-# A benchmark times what it starts itself: no background compile of impactsym's
-# drivers (impactsym.warmup) may run beside its timed blocks. The performance
-# benchmark runs and times that compile in the foreground instead.
-os.environ["IMPACTSYM_BACKGROUND_COMPILE"] = "0"
 
 SUBCOMMANDS = {
     "accuracy": "benchmarks.accuracy",

@@ -1,5 +1,19 @@
 """`python -m derive`: prove, then regenerate generated/; `--check`: fail if stale.
 
+How a kernel family gets into the runtime (the whole contract): write a derive
+module ``derive/<name>.py`` with ``KERNELS`` (a tuple of derive.kernel.Kernel;
+``EMITTED`` instead when what is emitted differs from what is proved, e.g.
+specialised variants), ``proofs()`` returning (claim, passed) pairs, and
+optionally ``DATA`` ((NAME, plain literal) pairs); add ``name`` to
+MODEL_MODULES below (and to PER_SCENE_ONLY_MODULES if it needs no batch
+driver). `python -m derive` then writes generated/<name>.py (per-scene
+functions), generated/<name>_jit.py (one numba driver per kernel) and the
+kernel's row in generated/registry.py: family (Kernel.family, default its
+name), variant (Kernel.variant), module, driver columns, inputs, outputs,
+constants, tier, operations; a module's DATA is published there too. The
+runtime finds kernels only through that registry (impactsym/_kernels/), so
+nothing else has to be written for a batch or a single scene to run them.
+
 Emission always runs every proof first and stops at the first failure.
 `--check` re-renders in memory, compares bytes with generated/ and prints a
 unified diff of every stale file (it does not re-run the proofs: the files it
@@ -50,19 +64,22 @@ def render_all() -> dict[str, str]:
 
     from . import emit
 
+    from .specialise import REQUEST_TIERS
+
     digest = emit.source_hash()
     files = {}
+    listed = []
     for name in MODEL_MODULES:
         mod = importlib.import_module(f"derive.{name}")
         doc = (mod.__doc__ or "").strip().splitlines()[0]
         kernels = getattr(mod, "EMITTED", mod.KERNELS)
+        data = getattr(mod, "DATA", ())
         drivers = name not in PER_SCENE_ONLY_MODULES
-        files[f"{name}.py"] = emit.render_module(
-            f"{name}.py", doc, kernels, digest, data=getattr(mod, "DATA", ()), drivers=drivers
-        )
+        files[f"{name}.py"] = emit.render_module(f"{name}.py", doc, kernels, digest, data=data, drivers=drivers)
         if drivers:
             files[f"{name}_jit.py"] = emit.render_jit_module(f"{name}.py", kernels, digest)
-    files["codes.py"] = emit.render_codes(digest)
+        listed.append((name, kernels, data, drivers))
+    files["registry.py"] = emit.render_registry(listed, digest, REQUEST_TIERS)
     files["__init__.py"] = emit.render_init(MODEL_MODULES, digest)
     return files
 

@@ -101,6 +101,8 @@ def energy_kernel(n: int) -> Kernel:
         sp.GreaterThan(ci, 0) for ci in depths
     )
     return Kernel(
+        family="crash3_energy",
+        variant=(("points", n),),
         name=f"crash3_energy_{n}",
         doc=f"CRASH3 crush energy of a {n}-point profile, F/w = A + B*C; E = E_crush*(1 + tan^2 "
         "alpha_c), E_woolley = E_crush/cos(alpha_c), alpha_c = min(|alpha|, 45 deg).",

@@ -364,11 +364,8 @@ def column_names(kernel: Kernel) -> tuple[str, ...]:
 
 
 def tier(kernel: Kernel) -> str:
-    """The output tier a kernel serves: "velocities", "impulses" or "all"."""
-    for name in ("velocities", "impulses"):
-        if kernel.name.endswith(f"_{name}"):
-            return name
-    return "all"
+    """The output tier a kernel serves: "velocities", or "all"."""
+    return dict(kernel.variant).get("tier", "all")
 
 
 def manifest_entry(kernel: Kernel, operations: int) -> dict:
@@ -498,43 +495,56 @@ def body_function(prog: Program, style: Style = DEFAULT) -> str:
     return "\n".join(lines) + "\n"
 
 
-def driver_name(kernel: Kernel, parallel: bool, normal: bool) -> str:
-    """rigid_batch, rigid_batch_serial, rigid_batch_normal, rigid_batch_normal_serial."""
-    return f"{kernel.name}_batch" + ("_normal" if normal else "") + ("" if parallel else "_serial")
+def driver_name(kernel: Kernel) -> str:
+    """The kernel's one batch driver: rigid_batch."""
+    return f"{kernel.name}_batch"
 
 
-def driver_function(kernel: Kernel, parallel: bool, normal: bool, style: Style = DEFAULT) -> str:
-    """A batch driver into caller-owned outputs, one row per index. A kernel
-    in normal form gets drivers that take the angle (`_sincos` per row) and,
-    with `normal`, drivers that take (nx, ny) as given."""
+def driver_columns(kernel: Kernel) -> tuple[str, ...]:
+    """The driver's input columns: the kernel's arguments, and for a kernel in
+    normal form the angle just before (nx, ny)."""
     args = [str(s) for s in kernel.inputs]
-    angle = kernel.angle is not None and not normal
-    columns = list(column_names(kernel)) if angle else args
+    if kernel.angle is not None:
+        at = args.index("nx")
+        args.insert(at, str(kernel.angle))
+    return tuple(args)
+
+
+def driver_function(kernel: Kernel, style: Style = DEFAULT) -> str:
+    """The batch driver into caller-owned outputs, one row per index, a
+    `prange` loop (a batch of a few rows pays a few microseconds for the
+    launch: benchmarks/results/performance.md). A kernel in normal form takes
+    the angle and (nx, ny): one normal for every row as length-1 (nx, ny),
+    read once before the loop (no filled columns to write and read again); or
+    per row, the angle column of the batch's length (`_sincos` per row) or
+    else (nx, ny) columns (angles beyond SINCOS_LIMIT, whose normal the
+    runtime forms with NumPy)."""
+    args = [str(s) for s in kernel.inputs]
     outs = [f"out_{s}" for s in kernel.output_names()] + ["out_status", "out_flags"]
     ind = "        "
-    lines = [f"@{style.jit(parallel)}"]
+    lines = [f"@{style.jit(parallel=True)}"]
     lines += _wrap(
-        f"def {driver_name(kernel, parallel, normal)}(", [f"c_{c}" for c in columns] + outs, "):", " " * 8
+        f"def {driver_name(kernel)}(", [f"c_{c}" for c in driver_columns(kernel)] + outs, "):", " " * 8
     )
-    loop = f"for i in {'prange' if parallel else 'range'}(out_status.shape[0]):"
-    if not normal:
-        doc = f'    """{"Parallel" if parallel else "Serial"} batch of `{kernel.name}`{", the angle per row" if angle else ""}."""'
-        head = [f"    {loop}"] + ([f"{ind}ny, nx = _sincos(c_{kernel.angle}[i])"] if angle else [])
-        return "\n".join([*lines, doc, *head, *_row(kernel, args, outs, ind, angle)]) + "\n"
-    # One normal for the batch comes as length-1 arrays, read once before the
-    # loop: no filled (nx, ny) columns to write and read again (the one
-    # cos/sin per batch path); per-row normals (angles beyond SINCOS_LIMIT)
-    # take the second loop.
+    lines.append(f'    """Batch of `{kernel.name}` (see `_{kernel.name}_body`)."""')
+    if kernel.angle is None:
+        lines += ["    for i in prange(out_status.shape[0]):", *_row(kernel, args, outs, ind, False)]
+        return "\n".join(lines) + "\n"
+    angle = f"c_{kernel.angle}"
     lines += [
-        f'    """{"Parallel" if parallel else "Serial"} batch of `{kernel.name}`, the normal '
-        'given: one (nx, ny) for every row as length-1 arrays, or one per row."""',
+        "    n = out_status.shape[0]",
         "    if c_nx.shape[0] == 1:",
         "        nx, ny = c_nx[0], c_ny[0]",
-        f"        {loop}",
+        "        for i in prange(n):",
         *_row(kernel, args, outs, ind + "    ", True),
         "    else:",
-        f"        {loop}",
-        *_row(kernel, args, outs, ind + "    ", False),
+        f"        angle = {angle}.shape[0] == n",
+        "        for i in prange(n):",
+        "            if angle:",
+        f"                ny, nx = _sincos({angle}[i])",
+        "            else:",
+        "                nx, ny = c_nx[i], c_ny[i]",
+        *_row(kernel, args, outs, ind + "    ", True),
     ]
     return "\n".join(lines) + "\n"
 
@@ -552,8 +562,11 @@ def render_jit_module(model_file: str, kernels, digest: str, style: Style = DEFA
     """generated/<model>_jit.py as text: `_sincos`, and per kernel its body and
     drivers."""
     model = model_file.removesuffix(".py")
+    total = sum(program(k, style).operations for k in kernels)
     parts = [
         header(model_file, digest).rstrip("\n"),
+        f"# {len(kernels)} kernels, {total} arithmetic operations after common-subexpression elimination;",
+        "# one batch driver per kernel, <kernel>_batch.",
         "",
         f'"""Numba batch drivers of generated/{model}.py (see its MANIFEST and legend)."""',
         "",
@@ -565,19 +578,72 @@ def render_jit_module(model_file: str, kernels, digest: str, style: Style = DEFA
     if any(k.angle is not None for k in kernels):
         parts += ["", f"@{style.jit(inline=True)}", SINCOS_SOURCE]
     for knl in kernels:
-        parts += ["", body_function(program(knl, style), style)]
-        for normal in (False, True) if knl.angle is not None else (False,):
-            for parallel in (True, False):
-                parts += ["", driver_function(knl, parallel, normal, style)]
+        parts += ["", body_function(program(knl, style), style), "", driver_function(knl, style)]
     return "\n".join(parts).rstrip("\n") + "\n"
 
 
-def render_codes(digest: str) -> str:
-    """generated/codes.py: the status codes and flag bits as constants."""
-    lines = [header("codes.py", digest), '"""Row status codes and physics flag bits."""', ""]
-    lines += [f"STATUS_{k} = {v}" for k, v in STATUS.items()]
-    lines += [""] + [f"FLAG_{k} = {v}" for k, v in FLAGS.items()]
-    return "\n".join(lines) + "\n"
+def registry_entry(kernel: Kernel, module: str, drivers: bool) -> dict:
+    """One kernel's row of generated/registry.py (plain Python literals)."""
+    return {
+        "family": kernel.family_name(),
+        "variant": dict(kernel.variant),
+        "module": module,
+        "driver": driver_columns(kernel) if drivers else None,
+        **manifest_entry(kernel, program(kernel).operations),
+    }
+
+
+def _family_outputs(entries: dict) -> dict:
+    """Family → every output name its kernels return (computed or constant),
+    in the order of its first kernel, then of the others."""
+    families: dict = {}
+    for row in entries.values():
+        names = families.setdefault(row["family"], [])
+        for name in (*row["outputs"], *row["constants"]):
+            if name not in names:
+                names.append(name)
+    return {family: tuple(names) for family, names in families.items()}
+
+
+def render_registry(modules, digest: str, tiers: dict) -> str:
+    """generated/registry.py: every emitted kernel and what the runtime needs
+    to choose one, plain data (no numba, no math). `modules` holds, per
+    derive module, (name, kernels, data, drivers) as __main__.render_all
+    collects them; `tiers` the output tiers solve_batch accepts."""
+    entries = {}
+    data: list = []
+    for name, kernels, module_data, drivers in modules:
+        for knl in kernels:
+            entries[knl.name] = registry_entry(knl, name, drivers)
+        data += list(module_data)
+    tables = [
+        ("KERNELS", entries),
+        ("FAMILY_OUTPUTS", _family_outputs(entries)),
+        ("TIERS", tiers),
+        ("STATUS", dict(STATUS)),
+        ("FLAGS", dict(FLAGS)),
+        ("SINCOS_LIMIT", SINCOS_LIMIT),
+        *data,
+    ]
+    parts = [
+        header("emit.py", digest).rstrip("\n"),
+        f"# {len(entries)} kernels; see derive/__main__.py for how a kernel gets here.",
+        "",
+        '"""The kernel registry: every generated kernel, its family and variant, columns and',
+        "outputs, and the tables the runtime reads (tiers, status codes, flags, presets).",
+        "",
+        "KERNELS[name]: family, variant (what sets it apart in its family: critical, a fixed",
+        "input such as e_m, an output tier), module (generated/<module>.py holds the",
+        "per-scene function <name>, generated/<module>_jit.py the driver <name>_batch),",
+        "driver (its input columns in order, None if the kernel has no driver), doc,",
+        "columns (batch inputs), arguments (per-scene function arguments), outputs",
+        "(computed), constants (outputs fixed to a number), tier, angle, equations,",
+        'operations. FAMILY_OUTPUTS[family]: every output a family returns."""',
+        "",
+    ]
+    for name, value in tables:
+        parts += [f"{name} = {pprint.pformat(value, width=WIDTH, sort_dicts=False, compact=True)}", ""]
+    return "\n".join(parts).rstrip("\n") + "\n"
 
 
 def render_init(modules, digest: str) -> str:

@@ -261,6 +261,8 @@ def _kernel(rigid: bool) -> Kernel:
         blocks=blocks + (tolerances,),
         outputs=outputs,
         flags=flags,
+        family="inverse",
+        variant=(("model", "rigid" if rigid else "particle"),),
     )
 
 

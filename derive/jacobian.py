@@ -84,6 +84,8 @@ def jacobian_kernel(base: Kernel, name: str | None = None) -> Kernel:
         blocks=tuple(blocks),
         outputs=tuple(base.outputs) + tuple(outputs),
         constants=tuple(base.constants) + tuple(zeros),
+        family="jacobian",
+        variant=(("of", base.name),),
     )
 
 

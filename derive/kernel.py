@@ -55,6 +55,10 @@ class Kernel:
     `constants` (outputs that are a fixed number, published by name rather
     than computed), `finite` (see `finite_checked`) and `angle` (the angle
     input that the normal components (nx, ny) among `inputs` stand for).
+    `family` and `variant` place the kernel in the registry
+    (generated/registry.py): the family it belongs to (default: its name) and
+    what distinguishes it there, as (key, value) pairs: ("critical", True),
+    ("e_m", 1.0) for a fixed input, ("tier", "velocities") for pruned outputs.
     """
 
     name: str
@@ -67,6 +71,13 @@ class Kernel:
     constants: tuple[tuple[str, float], ...] = ()
     finite: tuple[sp.Symbol, ...] | None = None
     angle: sp.Symbol | None = None
+    family: str = ""
+    variant: tuple[tuple[str, object], ...] = ()
+
+    def family_name(self) -> str:
+        """The kernel family (the registry's key for a model): `family`, or
+        the kernel's own name when it is the only member of its family."""
+        return self.family or self.name
 
     @staticmethod
     def public_name(sym: sp.Symbol) -> str:

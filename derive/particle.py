@@ -190,6 +190,8 @@ def kernel(sticking: bool) -> Kernel:
         blocks=_kernel_blocks(sticking) + (tolerances,),
         outputs=OUTPUTS,
         flags=flags,
+        family="particle",
+        variant=(("critical", True),) if sticking else (),
     )
 
 

@@ -391,6 +391,8 @@ def kernel(sticking: bool) -> Kernel:
         blocks=_frame_blocks() + _impulse_blocks(sticking) + _final_blocks(sticking) + (tolerances,),
         outputs=OUTPUTS,
         flags=flags,
+        family="rigid",
+        variant=(("critical", True),) if sticking else (),
     )
 
 

@@ -28,9 +28,17 @@ from .frame import gamma, nx, ny
 from .kernel import Guard, IsFinite, Kernel, NotNaN
 
 # Output tiers of the forward kernels: each adds to the one before.
+# A tier is emitted as a kernel of its own only where it saves arithmetic:
+# the velocities tier (benchmarks/results/performance.md). "impulses" names the
+# outputs up to dV2 for solve_batch, served by the full kernel: pruned, it
+# kept every operation of the full one (the energies are differences of the
+# velocities it computes anyway).
 TIER_VELOCITIES = ("V1x", "V1y", "W1", "V2x", "V2y", "W2")
 TIER_IMPULSES = TIER_VELOCITIES + ("Pn", "Pt", "M", "mu", "mu_c", "dV1", "dV2")
-TIERS = {"velocities": TIER_VELOCITIES, "impulses": TIER_IMPULSES}
+TIERS = {"velocities": TIER_VELOCITIES}
+# Every output tier solve_batch accepts, by the outputs it returns (the last,
+# "energy", is every output of the full kernel); emitted into the registry.
+REQUEST_TIERS = {"velocities": TIER_VELOCITIES, "impulses": TIER_IMPULSES}
 
 
 def normal_form(kernel: Kernel) -> Kernel:
@@ -94,6 +102,8 @@ def fix_inputs(kernel: Kernel, name: str, values: dict, doc: str) -> Kernel:
         constants=constants,
         finite=tuple(s for s in kernel.finite_checked() if s not in known),
         flags=tuple((flag, conds) for flag, conds in flags if conds),
+        family=kernel.family_name(),
+        variant=kernel.variant + tuple((str(sym), float(v)) for sym, v in values.items()),
     )
     return prune(fixed, name, fixed.output_names() + tuple(n for n, _ in constants))
 
@@ -119,9 +129,10 @@ def _evaluate(cond):
     return cond
 
 
-def prune(kernel: Kernel, name: str, outputs: tuple[str, ...], doc: str = "") -> Kernel:
+def prune(kernel: Kernel, name: str, outputs: tuple[str, ...], doc: str = "", tier: str = "") -> Kernel:
     """`kernel` computing only the outputs named in `outputs` (public names),
-    plus whatever its guards and flags need; `doc` is added to its docstring."""
+    plus whatever its guards and flags need; `doc` is added to its docstring,
+    `tier` (when given) to its registry variant."""
     keep = tuple(s for s in kernel.outputs if kernel.public_name(s) in outputs)
     needed = set(keep)
     for guard in kernel.checks:
@@ -146,6 +157,8 @@ def prune(kernel: Kernel, name: str, outputs: tuple[str, ...], doc: str = "") ->
         outputs=keep,
         constants=tuple((n, v) for n, v in kernel.constants if n in outputs),
         finite=tuple(s for s in kernel.finite_checked() if s in computed),
+        family=kernel.family_name(),
+        variant=kernel.variant + ((("tier", tier),) if tier else ()),
     )
 
 
@@ -159,6 +172,6 @@ def _symbols(conditions) -> set:
 def tiers(kernel: Kernel) -> tuple[Kernel, ...]:
     """The pruned kernels of every tier below "all", then `kernel` itself."""
     return tuple(
-        prune(kernel, f"{kernel.name}_{tier}", names, f"Outputs: {tier} only.")
+        prune(kernel, f"{kernel.name}_{tier}", names, f"Outputs: {tier} only.", tier)
         for tier, names in TIERS.items()
     ) + (kernel,)

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _kernels, uncertainty_cli, warmup
+from . import _kernels, uncertainty_cli
 from ._version import __version__
 from .codes import describe_status
 from .compare import compare
@@ -493,27 +493,17 @@ def _run_validate(args: argparse.Namespace) -> int:
 
 def _add_compile(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quiet", action="store_true", help="print nothing")
-    parser.add_argument("--claimed", action="store_true", help=argparse.SUPPRESS)
 
 
 def _run_compile(args: argparse.Namespace) -> int:
-    """Compile every batch driver once for this machine (impactsym.warmup),
-    and the loops of exact percentiles."""
+    """Compile every batch driver once for this machine, and the loops of
+    exact percentiles."""
     from . import _selection  # imports numba: only this command needs it
 
-    where, digest = _kernels.generated.__file__, _kernels.generated_digest()
     start = time.perf_counter()
-    try:
-        count = _kernels.compile_all(None if args.quiet else print) + _selection.compile_loops()
-    except BaseException:
-        warmup.release(where, digest)
-        raise
-    warmup.finish(where, digest)
+    count = _kernels.compile_all(None if args.quiet else print) + _selection.compile_loops()
     if not args.quiet:
-        print(
-            f"compiled or loaded {count} batch drivers and loops in {time.perf_counter() - start:.0f} s; "
-            f"cache: {warmup.cache_dir(where)}"
-        )
+        print(f"compiled or loaded {count} batch drivers and loops in {time.perf_counter() - start:.0f} s")
     return 0
 
 
@@ -555,8 +545,7 @@ COMMANDS: dict[str, Command] = {
         _run_sample,
     ),
     "compile": Command(
-        "compile every batch kernel for this machine now (otherwise done once in the background "
-        "after the first batch)",
+        "compile every batch kernel for this machine now (otherwise each compiles on its first use)",
         _add_compile,
         _run_compile,
     ),

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import _kernels
 from ._util import require
 from .codes import FLAG_ENERGY_CREATED, FLAG_MU_BEYOND_CRITICAL, FLAG_TENSILE_IMPULSE
 from .result import UNIT_LABELS
@@ -31,25 +32,7 @@ __all__ = [
 ]
 
 #: Output columns of a sweep frame (as ``solve_batch`` names them); ``mu`` is also an input.
-SWEEP_OUTPUTS = (
-    "V1x",
-    "V1y",
-    "W1",
-    "V2x",
-    "V2y",
-    "W2",
-    "Pn",
-    "Pt",
-    "M",
-    "mu",
-    "mu_c",
-    "dV1",
-    "dV2",
-    "TL",
-    "TLn",
-    "TLt",
-    "TLm",
-)
+SWEEP_OUTPUTS = _kernels.OUTPUTS
 #: Flag bits that make a solved row physically impossible on a sweep plot.
 IMPOSSIBLE_FLAGS = FLAG_ENERGY_CREATED | FLAG_TENSILE_IMPULSE | FLAG_MU_BEYOND_CRITICAL
 IMPOSSIBLE_LABEL = "physically impossible (energy created, tensile impulse or μ beyond μ_c)"

@@ -7,7 +7,7 @@ module-level and inside functions, absolute and relative (``from . import x``,
 - no import cycle among impactsym modules (a function-level import counts: it
   holds a cycle together as surely as a module-level one);
 - the runtime never imports ``sympy`` or ``derive``;
-- exactly one module, ``impactsym/_kernels.py`` (the door), imports the
+- exactly one module, ``impactsym/_kernels/registry.py`` (the door's reader), imports the
   generated code (``generated`` or ``impactsym._generated``).
 """
 
@@ -18,7 +18,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "impactsym"
-DOOR = "impactsym._kernels"
+DOOR = "impactsym._kernels.registry"
 GENERATED = ("generated", "impactsym._generated")
 
 

@@ -1,30 +1,21 @@
-"""Small batches before numba loads: the per-scene functions row by row.
+"""The per-scene functions and the numba drivers give the same bits.
 
-A batch of fewer than `_kernels.PYTHON_BELOW` rows, in a process that has not
-loaded the model's numba drivers, runs the kernel's per-scene function row by
-row. Which path a batch takes must not show in its results: for every kernel
-the runtime drives, random rows (and rows that fail every way a row can)
-give the same bits, status and flags through the per-scene functions as
-through the numba drivers.
+A single scene runs a kernel's per-scene function (generated/<model>.py, plain
+Python); a batch runs its numba driver (generated/<model>_jit.py). Which path a
+row takes must not show in its results: for every kernel with a driver, random
+rows (and rows that fail every way a row can) give the same bits, status and
+flags through the per-scene function, row by row, as through `run_batch`.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import math
-import os
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from impactsym import _kernels
-
-# The runtime's threshold, read when this module is imported: conftest.py sets
-# it to 0 for each test of the rest of the suite.
-PYTHON_BELOW = _kernels.PYTHON_BELOW
+from impactsym._kernels import registry
 
 # Ranges of the random inputs by name (anything else: uniform in [-3, 3]).
 POSITIVE = {"m1", "m2", "I1", "I2", "A", "B", "width", "rg1", "rg2", "mass", "inertia", "E", "r", "TL"}
@@ -60,10 +51,7 @@ SPECIAL = [
 
 
 def _kernel_sets():
-    by_name = {}
-    for ks, _parallel, _normal in _kernels.batch_drivers():
-        by_name.setdefault(ks.name, ks)
-    return list(by_name.values())
+    return list(registry.batch_kernels())
 
 
 def _columns(ks, n: int, seed: int) -> list:
@@ -81,19 +69,33 @@ def _columns(ks, n: int, seed: int) -> list:
     return columns
 
 
-def _both_paths(ks, inputs: list, n: int, monkeypatch):
-    """(per-scene rows, numba drivers) results of run_batch on the same inputs."""
-    with monkeypatch.context() as m:
-        m.setattr(_kernels, "_JIT_MODULES", {})
-        m.setattr(_kernels, "PYTHON_BELOW", PYTHON_BELOW)
-        m.setattr(_kernels, "_python_rows", 0)
-        m.setattr(_kernels, "_after_first_batch", lambda: None)
-        python = _kernels.run_batch(ks, [c.copy() if isinstance(c, np.ndarray) else c for c in inputs], n)
-        assert _kernels._JIT_MODULES == {}, "the small batch loaded the numba drivers"
-    with monkeypatch.context() as m:
-        m.setattr(_kernels, "PYTHON_BELOW", 0)
-        drivers = _kernels.run_batch(ks, inputs, n)
-    return python, drivers
+def _values(column, n: int) -> list:
+    """A column as n Python floats (a scalar repeated)."""
+    if isinstance(column, np.ndarray):
+        return column.tolist()
+    return [float(column)] * n
+
+
+def _scene_rows(ks, inputs: list, n: int):
+    """(outputs, status, flags) of the per-scene function, row by row. The
+    normal of a row as the runtime forms it (conventions of the runner): the
+    kernel's `unit_normal` of the angle, except when a finite angle of the
+    column lies beyond SINCOS_LIMIT: then NumPy's cos/sin for the column."""
+    rows = [_values(c, n) for c in inputs]
+    if ks.angle is not None:
+        at = ks.inputs.index(ks.angle)
+        angle = np.asarray(rows[at])
+        beyond = np.isfinite(angle) & (np.abs(angle) > registry.SINCOS_LIMIT)
+        if isinstance(inputs[at], np.ndarray) and beyond.any():
+            with np.errstate(invalid="ignore"):
+                nx, ny = np.cos(angle).tolist(), np.sin(angle).tolist()
+        else:
+            nx, ny = zip(*map(ks.unit_normal, rows[at]))
+        rows[at : at + 1] = [nx, ny]
+    results = list(map(ks.scene, *rows))
+    columns = list(zip(*results))
+    outs = {name: np.array(columns[k], dtype=float) for k, name in enumerate(ks.outputs)}
+    return outs, np.array(columns[-2], dtype=np.int32), np.array(columns[-1], dtype=np.int32)
 
 
 def _assert_same(python, drivers, label: str) -> None:
@@ -106,108 +108,29 @@ def _assert_same(python, drivers, label: str) -> None:
 
 
 @pytest.mark.parametrize("ks", _kernel_sets(), ids=lambda ks: ks.name)
-def test_rows_in_python_equal_the_drivers_bitwise(ks, monkeypatch):
-    """Per-row columns, the special rows among them: the same bits both ways, and
-    the per-scene path really ran (it did not fall back to the drivers)."""
+def test_rows_in_python_equal_the_drivers_bitwise(ks):
+    """Per-row columns, the special rows among them, and the ordinary rows
+    alone (per-row angles within SINCOS_LIMIT: `_sincos` in the driver): the
+    same bits both ways."""
     n = 400
     inputs = _columns(ks, n, seed=len(ks.name))
-    python, drivers = _both_paths(ks, inputs, n, monkeypatch)
-    _assert_same(python, drivers, ks.name)
-    # the ordinary rows alone: the per-scene path itself ran (no fallback)
+    drivers = _kernels.run_batch(ks, inputs, n)
+    _assert_same(_scene_rows(ks, inputs, n), drivers, ks.name)
     rows = [c[len(SPECIAL) :] for c in inputs]
     m = n - len(SPECIAL)
-    outs = {name: np.empty(m) for name in ks.outputs}
-    status, flags = np.empty(m, np.int32), np.empty(m, np.int32)
-    columns, normal = _kernels._columns_for(ks, rows, m)
-    assert _kernels._run_rows(ks, columns, normal, outs, status, flags), f"{ks.name}: a row raised"
-    _assert_same((outs, status, flags), _both_paths(ks, rows, m, monkeypatch)[1], f"{ks.name} (_run_rows)")
+    _assert_same(_scene_rows(ks, rows, m), _kernels.run_batch(ks, rows, m), f"{ks.name} (ordinary rows)")
     ok = np.count_nonzero(drivers[1] == 0)
     assert ok >= n // 10, f"{ks.name}: only {ok} of {n} random rows solved: the test checks too little"
 
 
 @pytest.mark.parametrize("family", ["rigid", "particle"])
-def test_scalar_columns_and_one_normal(family, monkeypatch):
-    """Scalars for masses, coefficients and the angle (the normal form with a
-    length-1 normal): the same bits both ways."""
+@pytest.mark.parametrize("n", [1, 300])
+def test_scalar_columns_and_one_normal(family, n):
+    """Scalars for masses, coefficients and the angle (one normal for the
+    batch, read once by the driver), one row or many: the same bits both ways."""
     ks = _kernels.kernel_for(family, False)
-    n = 300
     inputs = _columns(ks, n, seed=11)
     for name in ("m1", "I2", "e", "mu", "gamma"):
         if name in ks.inputs:
             inputs[ks.inputs.index(name)] = float(inputs[ks.inputs.index(name)][-1])
-    python, drivers = _both_paths(ks, inputs, n, monkeypatch)
-    _assert_same(python, drivers, f"{family} scalars")
-
-
-def test_a_row_python_cannot_evaluate_falls_back_to_the_drivers(monkeypatch):
-    """A per-scene function that raises (Python float arithmetic raises where
-    numba's returns inf or NaN): the batch runs through the drivers instead."""
-    ks = _kernels.kernel_for("particle", False)
-
-    def raising(*args):
-        raise ValueError("math domain error")
-
-    broken = dataclasses.replace(ks, scene=raising)
-
-    n = 50
-    inputs = _columns(ks, n, seed=3)
-    with monkeypatch.context() as m:
-        m.setattr(_kernels, "PYTHON_BELOW", 0)
-        want = _kernels.run_batch(ks, inputs, n)
-    with monkeypatch.context() as m:
-        m.setattr(_kernels, "_JIT_MODULES", {})
-        m.setattr(_kernels, "PYTHON_BELOW", PYTHON_BELOW)
-        m.setattr(_kernels, "_python_rows", 0)
-        m.setattr(_kernels, "_after_first_batch", lambda: None)
-        got = _kernels.run_batch(broken, inputs, n)
-    _assert_same(got, want, "fallback")
-
-
-def test_a_small_first_batch_does_not_import_numba():
-    """In a fresh process, a first sweep of 900 points and a 5,000-row
-    solve_batch return without importing numba; a batch of PYTHON_BELOW rows
-    loads the drivers."""
-    code = (
-        "import sys, numpy as np, impactsym\n"
-        "from impactsym import _kernels\n"
-        "impactsym.sweep('examples/intersection_si.toml', e=np.linspace(0, 1, 30), "
-        "mu=np.linspace(-0.3, 0.3, 30))\n"
-        "impactsym.solve_batch(dict(m1=1500.0, m2=1200.0, I1=2500.0, I2=2000.0, "
-        "v1x=np.full(5000, 15.0), v1y=0.0, w1=0.0, v2x=0.0, v2y=10.0, w2=0.0, r1x=1.5, "
-        "r1y=0.5, r2x=-0.5, r2y=1.0, gamma=0.3, e=0.2, mu=0.1, e_m=0.5))\n"
-        "print('numba' in sys.modules)\n"
-        "impactsym.solve_batch(dict(m1=1500.0, m2=1200.0, I1=2500.0, I2=2000.0, "
-        "v1x=np.full(_kernels.PYTHON_BELOW, 15.0), v1y=0.0, w1=0.0, v2x=0.0, v2y=10.0, "
-        "w2=0.0, r1x=1.5, r1y=0.5, r2x=-0.5, r2y=1.0, gamma=0.3, e=0.2, mu=0.1, e_m=0.5))\n"
-        "print('numba' in sys.modules)\n"
-    )
-    env = {"IMPACTSYM_BACKGROUND_COMPILE": "0"}
-    run = subprocess.run(
-        [sys.executable, "-c", code],
-        capture_output=True,
-        text=True,
-        env={**os.environ, **env},
-        cwd=Path(__file__).resolve().parents[1],
-        timeout=600,
-    )
-    assert run.returncode == 0, run.stderr
-    assert run.stdout.split() == ["False", "True"], run.stdout
-
-
-def test_the_budget_is_per_process_not_per_call(monkeypatch):
-    """Small batches run in Python only until the process has run PYTHON_BELOW
-    rows that way; then the drivers load, so a loop of small batches is not left
-    in Python."""
-    ks = _kernels.kernel_for("particle", False)
-    inputs = _columns(ks, 400, seed=5)
-    with monkeypatch.context() as m:
-        m.setattr(_kernels, "_JIT_MODULES", {})
-        m.setattr(_kernels, "PYTHON_BELOW", 1000)
-        m.setattr(_kernels, "_python_rows", 0)
-        m.setattr(_kernels, "_after_first_batch", lambda: None)
-        for _ in range(2):
-            _kernels.run_batch(ks, inputs, 400)
-        assert _kernels._JIT_MODULES == {} and _kernels._python_rows == 800
-        _kernels.run_batch(ks, inputs, 400)
-        assert ks.model in _kernels._JIT_MODULES, "the third batch did not load the drivers"
-        assert _kernels._python_rows == 800
+    _assert_same(_scene_rows(ks, inputs, n), _kernels.run_batch(ks, inputs, n), f"{family} scalars")
