@@ -63,7 +63,6 @@ def render_all() -> dict[str, str]:
     import importlib
 
     from . import emit
-
     from .specialise import REQUEST_TIERS
 
     digest = emit.source_hash()
@@ -75,7 +74,9 @@ def render_all() -> dict[str, str]:
         kernels = getattr(mod, "EMITTED", mod.KERNELS)
         data = getattr(mod, "DATA", ())
         drivers = name not in PER_SCENE_ONLY_MODULES
-        files[f"{name}.py"] = emit.render_module(f"{name}.py", doc, kernels, digest, data=data, drivers=drivers)
+        files[f"{name}.py"] = emit.render_module(
+            f"{name}.py", doc, kernels, digest, data=data, drivers=drivers
+        )
         if drivers:
             files[f"{name}_jit.py"] = emit.render_jit_module(f"{name}.py", kernels, digest)
         listed.append((name, kernels, data, drivers))

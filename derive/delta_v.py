@@ -50,7 +50,7 @@ def _blocks():
         ),
         Block(
             ((Cnn, C[0, 0]), (Cnt, C[0, 1]), (Ctt, C[1, 1])),
-            equation="compliance C of the impact centre from impulse-momentum (six equations 1, 2)",
+            equation="compliance C of the impact centre from impulse-momentum (seed appendix eqs 1-3)",
         ),
         # 1 - e as one rounded quantity (SymPy would flatten it into the sum).
         Block(

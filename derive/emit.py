@@ -29,7 +29,7 @@ import functools
 import hashlib
 import pprint
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import sympy as sp
@@ -202,7 +202,9 @@ def program(kernel: Kernel, style: Style = DEFAULT) -> Program:
     """Common subexpressions eliminated over the whole kernel; each temporary
     is placed at the start of the first block that needs it (directly or
     through another temporary), so it follows every guard of the blocks
-    before and every symbol it uses."""
+    before and every symbol it uses. Assignments nothing reads are left out
+    (`_live`)."""
+    kernel = _live(kernel)
     exprs = [x for block in kernel.blocks for _, x in block.assigns]
     for block in kernel.blocks:
         own = {s for s, _ in block.assigns}
@@ -238,6 +240,27 @@ def program(kernel: Kernel, style: Style = DEFAULT) -> Program:
             steps.append(("guard", block.guard))
     flags = tuple((flag, tuple(style.code(c) for c in conds)) for flag, conds in kernel.flags)
     return Program(kernel, tuple(steps) + (("flags", flags),), int(operations))
+
+
+def _live(kernel: Kernel) -> Kernel:
+    """`kernel` without dead stores: an assignment stays when an output, the
+    finite check, a guard, a flag or a later kept assignment reads it (a
+    derivation may name a quantity that only some of its kernels use: r12 in
+    the sliding rigid kernel)."""
+    needed = {*kernel.outputs, *kernel.finite_checked()}
+    for guard in kernel.checks:
+        needed |= set().union(*(c.free_symbols for c in guard.conditions))
+    for _, conds in kernel.flags:
+        needed |= set().union(*(sp.sympify(c).free_symbols for c in conds))
+    blocks = []
+    for block in reversed(kernel.blocks):
+        if block.guard is not None:
+            needed |= set().union(*(c.free_symbols for c in block.guard.conditions))
+        assigns = tuple((sym, x) for sym, x in block.assigns if sym in needed)
+        for _, x in assigns:
+            needed |= x.free_symbols
+        blocks.append(replace(block, assigns=assigns))
+    return replace(kernel, blocks=tuple(reversed(blocks)))
 
 
 def _tidy(temps, reduced, kernel: Kernel):
@@ -427,7 +450,14 @@ def _legend(kernels) -> list[str]:
         for sym in knl.definitions():
             if str(sym) not in names and sym not in knl.outputs:
                 names.append(str(sym))
-    lines = ["#", "# Intermediate names (inputs and outputs: conventions.md):"]
+    lines = [
+        "#",
+        "# Equations: 'seed appendix eq N' numbers the six equations of the seed's appendix in",
+        "# its own order (1, 2 momentum along x, y; 3 angular momentum; 4 restitution; 5 friction",
+        "# (impulse ratio); 6 moment restitution); 'seed eq N' the seed's numbered equations.",
+        "#",
+        "# Intermediate names (inputs and outputs: conventions.md):",
+    ]
     for name in names:
         lines.append(f"#   {name:<10} {LEGEND.get(name, 'see derive/')}")
     lines.append(f"#   {'_t<k>':<10} common subexpressions (eliminated across a kernel's blocks)")

@@ -141,8 +141,8 @@ def _rigid_blocks():
                     (M, (1 - e_m) * Wr / (e_m * Jsum)),
                 ),
                 _separating_guard(),
-                equation="compliance C (six equations 1, 2); M from moment restitution "
-                "(six equations 5) solved for M",
+                equation="compliance C (seed appendix eqs 1-3); M from moment restitution "
+                "(seed appendix eq 6) solved for M",
             ),
             Block(
                 ((Dn, Cnn + mu * Cnt), (dgn_inv, (1 + e) * Gn / e)),
@@ -152,9 +152,9 @@ def _rigid_blocks():
             ),
             Block(
                 ((Pn, -(dgn_inv + Cnm * M) / Dn),),
-                equation="Pn from gn - Gn = Cnn Pn + Cnt Pt + Cnm M with Pt = mu Pn (seed eq 5, six equations 4)",
+                equation="Pn from gn - Gn = Cnn Pn + Cnt Pt + Cnm M with Pt = mu Pn (seed eq 5, seed appendix eq 5)",
             ),
-            Block(((Pt, mu * Pn),), equation="impulse ratio Pt = mu Pn (seed eq 5, six equations 4)"),
+            Block(((Pt, mu * Pn),), equation="impulse ratio Pt = mu Pn (seed eq 5, seed appendix eq 5)"),
             Block(
                 (
                     (Px, px),
@@ -180,7 +180,7 @@ def _rigid_blocks():
                     (TLt, Pt * (gt + Gt) / 2),
                     (TLm, M * (wr + Wr) / 2),
                 ),
-                equation="initial velocities (six equations 1, 2); work of Pn, Pt, M "
+                equation="initial velocities (seed appendix eqs 1-3); work of Pn, Pt, M "
                 "(seed eqs 21-26, conventions.md energy)",
             ),
             Block(((TL, TLn + TLt + TLm),), equation="TL = TLn + TLt + TLm (conventions.md energy)"),

@@ -173,8 +173,8 @@ def _frame_blocks():
                 (wc, (1 - e_m) * jbar),
             ),
             f.approach_guard(),
-            equation="compliance C from impulse-momentum (six equations 1, 2); "
-            "moment restitution (six equations 5)",
+            equation="compliance C from impulse-momentum (seed appendix eqs 1-3); "
+            "moment restitution (seed appendix eq 6)",
         ),
     )
 
@@ -226,8 +226,8 @@ def compliance_pieces():
                 (Cnm, C[0, 2]),
                 (Ctm, C[1, 2]),
             ),
-            equation="compliance C from impulse-momentum (six equations 1, 2); "
-            "moment restitution (six equations 5)",
+            equation="compliance C from impulse-momentum (seed appendix eqs 1-3); "
+            "moment restitution (seed appendix eq 6)",
         ),
     )
 
@@ -267,7 +267,7 @@ def _impulse_blocks(sticking: bool):
     return (
         Block(
             tuple(keff.items()) + ((dgn, -(1 + e) * gn),),
-            equation="effective compliance K (M eliminated); restitution (seed eq 3, six equations 3)",
+            equation="effective compliance K (M eliminated); restitution (seed eq 3, seed appendix eq 4)",
         ),
         Block(((bn, -(dgn + hn)), (bt, gt - ht)), equation="K (Pn, Pt) = (bn, bt)"),
         Block(
@@ -276,7 +276,7 @@ def _impulse_blocks(sticking: bool):
             equation=(
                 "no sliding at separation (seed eq 8)"
                 if sticking
-                else "impulse ratio Pt = mu Pn (seed eq 5, six equations 4)"
+                else "impulse ratio Pt = mu Pn (seed eq 5, seed appendix eq 5)"
             ),
         ),
         # μ_c: the ratio Pt/Pn of the sticking solution (det K cancels).
@@ -356,7 +356,7 @@ def _final_blocks(sticking: bool):
                 (W1, w1 + dw1),
                 (W2, w2 + dw2),
             ),
-            equation="final velocities from impulse-momentum (six equations 1, 2)",
+            equation="final velocities from impulse-momentum (seed appendix eqs 1-3)",
         ),
         Block(
             (
@@ -364,7 +364,7 @@ def _final_blocks(sticking: bool):
                 # W2 - W1 = e_m·s at separation.
                 (TLm, am * s * (wr + e_m * s) / 2),
             ),
-            equation="moment impulse (six equations 5) and its work",
+            equation="moment impulse (seed appendix eq 6) and its work",
         ),
         Block(((TL, TLn + TLt + TLm),), equation="TL = TLn + TLt + TLm (conventions.md energy)"),
     )

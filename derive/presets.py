@@ -249,7 +249,7 @@ def _final_blocks():
                 (W2, w2 - j2 * c2),
                 (TLm, sp.Integer(0)),
             ),
-            equation="final velocities from impulse-momentum (six equations 1, 2)",
+            equation="final velocities from impulse-momentum (seed appendix eqs 1-3)",
         ),
         Block(((TL, TLn + TLt),), equation="TL = TLn + TLt (conventions.md energy)"),
     )

@@ -151,7 +151,7 @@ def _blocks():
                     (s2, (h1x * py_tot - h1y * px_tot) / (m2 * hcross)),
                 ),
                 equation="speeds from linear momentum m1 s1 h1 + m2 s2 h2 = p (seed eqs 1, 2; "
-                "six equations 1), by Cramer's rule",
+                "seed appendix eqs 1, 2), by Cramer's rule",
             ),
             Block(
                 (
@@ -174,7 +174,7 @@ def _blocks():
                     (Gt, f.to_impact_frame(*G)[1]),
                 ),
                 f.approach_guard(),
-                equation="P = m1 (V1 - v1) (seed eqs 4, 6; six equations 1); u2 - u1 at the impact "
+                equation="P = m1 (V1 - v1) (seed eqs 4, 6; seed appendix eqs 1, 2); u2 - u1 at the impact "
                 "centre, before and after",
             ),
             Block(
@@ -190,7 +190,7 @@ def _blocks():
                     (pdof2, sp.atan2(Py, Px) - theta2),
                 ),
                 Guard((sp.Ne(Pn, 0),), "SINGULAR"),
-                equation="M_i from each angular impulse (six equations 2); e = -Gn/gn (seed eq 3); "
+                equation="M_i from each angular impulse (seed appendix eq 3); e = -Gn/gn (seed eq 3); "
                 "PDOF of the impulse",
             ),
             Block(
@@ -205,7 +205,7 @@ def _blocks():
                     (TLt, Pt * (gt + Gt) / 2),
                     (TLm, M * (wr + Wr) / 2),
                 ),
-                equation="moment restitution (six equations 5) solved for e_m; work of Pn, Pt, M "
+                equation="moment restitution (seed appendix eq 6) solved for e_m; work of Pn, Pt, M "
                 "(seed eqs 21-26, conventions.md energy)",
             ),
         )

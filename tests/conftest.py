@@ -1,5 +1,8 @@
 """Test-suite settings shared by every test module."""
 
+import os
+
+
 def pytest_configure(config):
     """Keep the random_realistic draws between runs in pytest's cache folder.
 

@@ -12,10 +12,10 @@ import pytest
 
 import impactsym
 from impactsym import codes
+from impactsym._kernels import OUTPUTS
 from impactsym.testing import scenes
 
 ROOT = Path(__file__).resolve().parent.parent
-OUTPUTS = ("V1x", "V1y", "W1", "V2x", "V2y", "W2", "Pn", "Pt", "M", "mu", "mu_c", "TL", "TLn", "TLt", "TLm")
 
 
 def _rigid(n=8, seed=3):
@@ -123,47 +123,22 @@ def test_any_mix_of_scalars_and_arrays_uses_one_compiled_signature():
         for name in OUTPUTS:
             np.testing.assert_array_equal(out[name], want[name], err_msg=f"{scalars} {name}")
     assert (reference["status"] == 0).all()
-    assert len(ks.batch.signatures) == 1
+    assert len(ks.driver.signatures) == 1
 
 
 def test_scalars_are_filled_chunk_by_chunk(monkeypatch):
     """A batch longer than a chunk with scalar columns gives the rows a single
     call would give (each chunk its own slice of the outputs)."""
-    from impactsym import _kernels
+    from impactsym._kernels import runner
 
     c = _rigid(250, seed=6)
     mixed = {k: (float(v[0]) if k in ("m1", "e") else v) for k, v in c.items()}
     whole = impactsym.solve_batch(mixed)
-    monkeypatch.setattr(_kernels, "FILL_BYTES", 8 * 2 * 64)  # two scalars: 64-row chunks
-    monkeypatch.setattr(_kernels, "MIN_CHUNK", 64)
+    monkeypatch.setattr(runner, "FILL_BYTES", 8 * 2 * 64)  # two scalars: 64-row chunks
+    monkeypatch.setattr(runner, "MIN_CHUNK", 64)
     chunked = impactsym.solve_batch(mixed)
     for name in (*OUTPUTS, "status", "flags"):
         np.testing.assert_array_equal(chunked[name], whole[name], err_msg=name)
-
-
-def test_a_slow_first_compile_says_so(monkeypatch, capsys):
-    """A driver without a compiled signature that takes longer than
-    COMPILE_NOTICE_AFTER prints one line to stderr; a compiled one prints nothing."""
-    import time
-
-    from impactsym import _kernels
-
-    class Driver:
-        def __init__(self, signatures):
-            self.signatures = signatures
-
-        def __call__(self, *args):
-            time.sleep(0.3)
-
-    monkeypatch.setattr(_kernels, "COMPILE_NOTICE_AFTER", 0.05)
-    ks = _kernels.kernel_for("rigid", False)
-    outs = [np.empty(3), np.empty(3, dtype=np.int32)]
-    _kernels._call(ks, Driver([]), True, [np.zeros(3)], outs)
-    _kernels._call(ks, Driver(["compiled"]), True, [np.zeros(3)], outs)
-    err = capsys.readouterr().err.splitlines()
-    assert err == [err[0]] and err[0].startswith(
-        "impactsym: compiling the rigid batch kernel for this machine (once; about "
-    )
 
 
 def test_a_read_only_install_caches_compiled_drivers_in_the_user_directory(tmp_path):
@@ -172,8 +147,7 @@ def test_a_read_only_install_caches_compiled_drivers_in_the_user_directory(tmp_p
     code = (
         "import os; real = os.access; "
         "os.access = lambda p, m, **k: False if m == os.W_OK else real(p, m, **k); "
-        "import impactsym; from impactsym import _kernels; "
-        "_kernels.PYTHON_BELOW = 0; "  # a one-row batch runs the driver, not the per-scene function
+        "import impactsym; "
         "out = impactsym.solve_batch({'m1': [1500.0], 'm2': [1200.0], 'v1x': [20.0], "
         "'v1y': [0.0], 'v2x': [0.0], 'v2y': [0.0], 'gamma': 0.0, 'e': 0.2, 'mu': 0.1}, "
         "model='particle'); "
@@ -204,6 +178,6 @@ def test_a_read_only_install_caches_compiled_drivers_in_the_user_directory(tmp_p
     ],
 )
 def test_angles_beyond_the_sincos_limit_are_found_past_nan_and_inf(angles, beyond):
-    from impactsym._kernels import _beyond
+    from impactsym._kernels.runner import _beyond
 
     assert _beyond(np.array(angles), 10.0) is beyond

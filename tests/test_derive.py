@@ -98,10 +98,29 @@ def test_manifest_describes_every_kernel():
         assert callable(getattr(p, name)) and row["operations"] > 0
         assert row["angle"] == "gamma" and "gamma" in row["columns"]
         assert row["arguments"][14:16] == ("nx", "ny")
-        for suffix in ("", "_serial", "_normal", "_normal_serial"):
-            assert callable(getattr(pj, f"{name}_batch{suffix}"))
+        assert callable(getattr(pj, f"{name}_batch"))
+        assert not hasattr(pj, f"{name}_batch_serial") and not hasattr(pj, f"{name}_batch_normal")
     assert p.MANIFEST["rigid_em1"]["constants"] == {"M": 0.0, "TLm": 0.0}
     assert p.MANIFEST["rigid_velocities"]["tier"] == "velocities"
+
+
+def test_the_registry_lists_every_emitted_kernel():
+    """generated/registry.py has a row for every kernel of every listed derive
+    module, with the module that holds it, and a driver exactly when the
+    module has drivers; and nothing else."""
+    import generated.registry as registry
+
+    emitted = {knl.name: name for name, knl in _emitted_kernels()}
+    assert set(registry.KERNELS) == set(emitted)
+    for kernel, row in registry.KERNELS.items():
+        assert row["module"] == emitted[kernel]
+        assert (row["driver"] is None) == (row["module"] in derive_main.PER_SCENE_ONLY_MODULES)
+    assert registry.KERNELS["rigid_critical_em1_velocities"]["variant"] == {
+        "critical": True,
+        "e_m": 1.0,
+        "tier": "velocities",
+    }
+    assert registry.FAMILY_OUTPUTS["rigid"][:6] == ("V1x", "V1y", "W1", "V2x", "V2y", "W2")
 
 
 def _emitted_kernels():
@@ -229,3 +248,28 @@ def test_the_emitted_finiteness_test_is_every_isfinite(count):
     for row in rows:
         want = all(math.isfinite(x) for x in row)
         assert test(*row) is want and compiled(*row) == want, row
+
+
+def test_no_dead_stores_in_generated_code():
+    """Every name a per-scene function assigns is read later in it (the
+    emitter leaves out assignments nothing reads)."""
+    import re
+
+    dead = []
+    for path in sorted((ROOT / "generated").glob("*.py")):
+        for function in re.split(r"\ndef ", path.read_text())[1:]:
+            lines = function.split("\n")
+            for k, line in enumerate(lines):
+                assigned = re.match(r"    (\w+) = ", line)
+                later = "\n".join(lines[k + 1 :])
+                if assigned and not re.search(rf"\b{assigned.group(1)}\b", later):
+                    dead.append(f"{path.name}: {function.split('(')[0]} {assigned.group(1)}")
+    assert dead == []
+
+
+def test_every_generated_module_header_counts_operations():
+    """The plain and the numba modules both say how many operations their kernels take."""
+    for path in sorted((ROOT / "generated").glob("*.py")):
+        if path.name in ("__init__.py", "registry.py"):
+            continue
+        assert "arithmetic operations after common-subexpression elimination" in path.read_text()[:2000], path

@@ -32,6 +32,7 @@ __all__ = [
     "KernelSet",
     "as_input",
     "compile_all",
+    "generated",
     "generated_digest",
     "inverse_kernel_for",
     "kernel_for",

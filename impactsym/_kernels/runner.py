@@ -105,7 +105,9 @@ def _call(driver, columns: list, outs: list) -> None:
     fills = _fills(columns, size, scalars)
     for start in range(0, n, size):
         stop = min(start + size, n)
-        args = [_rows_of(c, start, stop, n) if f is None else f[: stop - start] for c, f in zip(columns, fills)]
+        args = [
+            _rows_of(c, start, stop, n) if f is None else f[: stop - start] for c, f in zip(columns, fills)
+        ]
         driver(*args, *(o[start:stop] for o in outs))
 
 
