@@ -18,7 +18,7 @@ on vehicle 1; lower case initial, upper case final).
 
 from . import plot
 from ._version import __version__ as __version__
-from .batch import solve_batch
+from .batch import percentiles, sample, solve_batch, sweep
 from .codes import FLAG_MESSAGES, STATUS_MESSAGES, describe_flags, describe_status
 from .compare import compare
 from .crash3 import crash3
@@ -30,7 +30,6 @@ from .reconstruct import reconstruct, reconstruct_batch
 from .result import Result
 from .scene import MODELS, Impact, Scene, SceneError, Vehicle, load_scene
 from .single import solve
-from .sweep import percentiles, sample, sweep
 
 __all__ = [
     "FLAG_MESSAGES",

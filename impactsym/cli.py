@@ -34,7 +34,7 @@ from .reconstruct import reconstruct
 from .result import UNIT_LABELS, json_clean, json_number, table_cell
 from .scene import SceneError
 from .single import solve
-from .sweep import (
+from .batch.sweeps import (
     CHUNK_SIZE,
     PERCENTILES,
     SWEEP_PERCENTILES,
@@ -45,7 +45,7 @@ from .sweep import (
     summary_columns,
     write_frame,
 )
-from .sweep import sweep as solve_sweep
+from .batch.sweeps import sweep as solve_sweep
 
 __all__ = ["COMMANDS", "Command", "build_parser", "main"]
 
@@ -498,10 +498,10 @@ def _add_compile(parser: argparse.ArgumentParser) -> None:
 def _run_compile(args: argparse.Namespace) -> int:
     """Compile every batch driver once for this machine, and the loops of
     exact percentiles."""
-    from . import _selection  # imports numba: only this command needs it
+    from .batch import selection  # imports numba: only this command needs it
 
     start = time.perf_counter()
-    count = _kernels.compile_all(None if args.quiet else print) + _selection.compile_loops()
+    count = _kernels.compile_all(None if args.quiet else print) + selection.compile_loops()
     if not args.quiet:
         print(f"compiled or loaded {count} batch drivers and loops in {time.perf_counter() - start:.0f} s")
     return 0

@@ -52,7 +52,7 @@ import numpy as np
 
 from . import _kernels
 from ._kernels import CODES as _codes
-from .sweep import BLOCK, CHUNK_SIZE, SamplePlan
+from .batch.sweeps import BLOCK, CHUNK_SIZE, SamplePlan
 from .uncertainty_commands import COMMANDS, COMPLEX_STEP, RECONSTRUCT, Command, command_for
 from .uncertainty_inputs import Input, cholesky, correlation_matrix
 from .uncertainty_result import KEEP, Stats, Uncertainty

@@ -15,7 +15,7 @@ import pandas as pd
 import pytest
 
 import impactsym
-from impactsym import batch, dask_engine
+from impactsym.batch import dask_engine, solve
 
 distributed = pytest.importorskip("distributed")
 
@@ -61,7 +61,7 @@ def test_sweep_on_the_cluster_equals_local(client):
 
 @pytest.mark.slow  # a two-process LocalCluster whose workers each load the kernels
 def test_sample_on_the_cluster_equals_local_whatever_the_chunks(client):
-    n = importlib.import_module("impactsym.sweep").BLOCK + 500
+    n = importlib.import_module("impactsym.batch.sweeps").BLOCK + 500
     local = impactsym.sample(SI, DISTS, n, seed=21, chunk_size=5000)
     dask = impactsym.sample(SI, DISTS, n, seed=21, chunk_size=9999, engine="dask")
     assert (local["status"] != 0).any()
@@ -103,7 +103,7 @@ def test_solve_batch_on_the_cluster_equals_local(client):
     columns = _columns(1000)
     local = impactsym.solve_batch(columns)
     via_engine = impactsym.solve_batch(columns, engine="dask")
-    chunked = batch.solve_batch_dask(columns, chunk_size=130)
+    chunked = solve.solve_batch_dask(columns, chunk_size=130)
     for result in (via_engine, chunked):
         assert list(result) == list(local)
         for name, column in local.items():
@@ -120,13 +120,13 @@ def test_solve_batch_of_a_dataframe_keeps_its_index(client):
         index=pd.Index(np.arange(300) * 3 + 1000, name="case"),
     )
     local = impactsym.solve_batch(frame, outputs="impulses")
-    assert_same(batch.solve_batch_dask(frame, outputs="impulses", chunk_size=64), local)
+    assert_same(solve.solve_batch_dask(frame, outputs="impulses", chunk_size=64), local)
     assert_same(impactsym.solve_batch(frame, outputs="impulses", engine="dask"), local)
 
 
 def test_solve_batch_with_unequal_columns_raises_one_line():
     with pytest.raises(ValueError, match=r"^e: length 3 differs from the other columns \(2\)$"):
-        batch.solve_batch_dask({"m1": np.ones(2), "e": np.ones(3)})
+        solve.solve_batch_dask({"m1": np.ones(2), "e": np.ones(3)})
 
 
 def test_without_dask_the_error_names_the_extra(monkeypatch):

@@ -463,7 +463,7 @@ def test_a_grid_too_large_for_memory_is_refused_before_any_work(capsys):
 
 def test_the_limits_follow_what_the_machine_has(monkeypatch, tmp_path):
     """The refusal is a comparison with the memory and disk the machine reports."""
-    from impactsym import _resources
+    from impactsym.batch import resources as _resources
 
     monkeypatch.setattr(_resources, "available_memory", lambda: 10**6)
     with pytest.raises(ValueError, match="in memory"):

@@ -106,13 +106,13 @@ def test_solve_batch_runs_the_specialised_kernel(rigid, monkeypatch):
     """e_m = 1 on every row and outputs="velocities" → rigid_em1_velocities;
     one e_m ≠ 1 → the general kernel of the tier."""
     used = []
-    real = _kernels.run_batch
+    real = _kernels.run
 
     def spy(ks, inputs, n=None):
         used.append(ks.scene.__name__)
         return real(ks, inputs, n)
 
-    monkeypatch.setattr(_kernels, "run_batch", spy)
+    monkeypatch.setattr(_kernels, "run", spy)
     impactsym.solve_batch(rigid, outputs="velocities")
     impactsym.solve_batch(dict(rigid, e_m=1.0), outputs=["TL"])
     mixed = rigid["e_m"].copy()

@@ -18,8 +18,8 @@ import pytest
 import impactsym
 from impactsym.cli import main
 
-sweeps = importlib.import_module("impactsym.sweep")  # impactsym.sweep is the function
-quantiles = importlib.import_module("impactsym._quantiles")
+sweeps = importlib.import_module("impactsym.batch.sweeps")
+quantiles = importlib.import_module("impactsym.batch.quantiles")
 
 ROOT = Path(__file__).resolve().parents[1]
 US = ROOT / "examples" / "two_car_us.json"  # rigid, mu = 0.3

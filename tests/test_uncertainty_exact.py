@@ -1,7 +1,7 @@
 """The fast paths of the uncertainty engine give the numbers of the plain ones, to the bit.
 
-- `impactsym._selection.select_ranks` (bin counting) against `numpy.partition`
-  of the concatenation, and `impactsym._quantiles.percentiles` against
+- `impactsym.batch.selection.select_ranks` (bin counting) against `numpy.partition`
+  of the concatenation, and `impactsym.batch.quantiles.percentiles` against
   `numpy.percentile` (the definition docs/uncertainty.md states), on data
   chosen to stress the bins: ties, a constant array, heavy tails, tiny and
   huge scales, values at the bin edges, NaN and infinities (which take the
@@ -14,9 +14,9 @@
 import numpy as np
 import pytest
 
-from impactsym import _selection
-from impactsym._plans import BLOCK, SamplePlan
-from impactsym._quantiles import percentiles
+from impactsym.batch import selection as _selection
+from impactsym.batch.plans import BLOCK, SamplePlan
+from impactsym.batch.quantiles import percentiles
 from impactsym.uncertainty_inputs import Input
 
 Q = (5.0, 50.0, 95.0)

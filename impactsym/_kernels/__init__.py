@@ -10,6 +10,9 @@ the presets, status codes and flags, and the kernels of each job.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from functools import cache
+
 from .compile import compile_all
 from .registry import (
     CODES,
@@ -36,6 +39,7 @@ __all__ = [
     "generated_digest",
     "inverse_kernel_for",
     "kernel_for",
+    "plan",
     "preset",
     "requested_outputs",
     "run",
@@ -123,6 +127,40 @@ def kernel_for(model: str, critical: bool, no_moment: bool = False, tier: str = 
     if tier != "energy":
         variant["tier"] = tier
     return select(model, **variant)
+
+
+@cache
+def forward_columns(model: str) -> tuple[str, ...]:
+    """The batch columns the forward kernels of a model name read (its
+    family's general kernel: a preset's fixed coefficients among them)."""
+    return kernel_for(preset(model)[0], False).inputs
+
+
+def every_forward_column() -> tuple[str, ...]:
+    """The columns any forward model reads."""
+    return tuple(dict.fromkeys(c for family in MODELS for c in forward_columns(family)))
+
+
+@dataclass(frozen=True)
+class Plan:
+    """What one forward batch group runs: `kernel`, the coefficients its
+    preset `fixed` (kernel input → value, ``"critical"`` for mu), and the
+    kernel inputs no column gives (`placeholders`: mu when mu = mu_c)."""
+
+    kernel: KernelSet
+    fixed: dict
+    placeholders: tuple[str, ...]
+
+
+@cache
+def plan(model: str, critical: bool, e_m_one: bool, tier: str) -> Plan:
+    """The plan of a group of rows of one model name: critical impulse ratio
+    (asked, or fixed by the preset), e_m = 1 on every row (`e_m_one`, or fixed
+    by the preset) and an output tier choose the most specialised kernel."""
+    family, fixed = preset(model)
+    critical = critical or fixed.get("mu") == "critical"
+    no_moment = e_m_one or fixed.get("e_m") == 1.0
+    return Plan(kernel_for(family, critical, no_moment, tier), fixed, ("mu",) if critical else ())
 
 
 def inverse_kernel_for(model: str) -> KernelSet:

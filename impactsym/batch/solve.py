@@ -22,111 +22,13 @@ results come back in the original row order.
 
 from __future__ import annotations
 
-import numbers
-from collections.abc import Mapping
-
 import numpy as np
 
-from . import _kernels
-from ._util import CHUNK_SIZE, is_dataframe, row_count, spans
-from .casefile import unknown_key
+from .. import _kernels
+from .._util import CHUNK_SIZE, is_dataframe, row_count, spans
+from ..scene import CRITICAL
+from .columns import as_column, check_columns, require_mapping
 from .dask_engine import map_chunks
-from .scene import CRITICAL
-
-#: Scene-file words for batch columns: a near miss of one suggests its column.
-_SCENE_WORDS = {
-    "restitution": "e",
-    "impulse_ratio": "mu",
-    "moment_restitution": "e_m",
-    "normal_angle": "gamma",
-    "mass": "m1",
-    "yaw_inertia": "I1",
-    "yaw_rate": "w1",
-}
-
-
-def check_columns(columns, known: tuple[str, ...], model: str, everywhere: tuple[str, ...] = ()) -> None:
-    """ValueError unless ``columns`` is a mapping (or DataFrame) of columns
-    that the kernel reads (``known``): a name in ``everywhere`` (read by other
-    models) is "given but not used by ``model``" (``"the particle model"``), any other is unknown, with
-    the nearest known name, as an unknown key of a scene file is."""
-    require_mapping(columns)
-    for name in columns:
-        if name in known:
-            continue
-        if name in everywhere:
-            raise ValueError(f"{name}: given but not used by {model} (its columns: {' '.join(known)})")
-        raise ValueError(f"{name}: {unknown_key(str(name), known, 'column', _SCENE_WORDS)}")
-
-
-def require_mapping(columns) -> None:
-    """ValueError unless ``columns`` is a mapping or a DataFrame of columns."""
-    if not (isinstance(columns, Mapping) or is_dataframe(columns)):
-        raise ValueError(_not_a_mapping(columns))
-
-
-def _not_a_mapping(columns) -> str:
-    """Why ``columns`` is not a batch, and what to pass instead."""
-    if isinstance(columns, np.ndarray) and columns.dtype.names:
-        return (
-            "columns: a structured array; pass a dict of its fields, "
-            "{name: a[name] for name in a.dtype.names}, or a pandas DataFrame"
-        )
-    if isinstance(columns, (list, tuple)):
-        return (
-            "columns: a list (one scene per item?); pass a dict of columns "
-            "(name -> array) or pandas.DataFrame(rows)"
-        )
-    return f"columns: must be a dict of columns (name -> array) or a DataFrame, got {type(columns).__name__}"
-
-
-_ALL_NUMBERS = object()  # no bad element found (None itself is a bad one)
-
-
-def _check_numbers(arr: np.ndarray, name: str) -> None:
-    """ValueError unless ``arr`` holds real numbers: a scene file refuses
-    true/false, text and null for a number, and so does a batch (NumPy would
-    read True as 1.0 and "0.3" as 0.3)."""
-    kind = arr.dtype.kind
-    if arr.dtype.names:
-        raise ValueError(
-            f"{name}: a structured array, not a numeric column "
-            f"(fields {', '.join(arr.dtype.names)}; pass one field)"
-        )
-    if kind in "fiu":
-        return
-    if kind == "O":
-        not_numbers = (
-            v for v in arr.flat if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real)
-        )
-        bad = next(not_numbers, _ALL_NUMBERS)
-        if bad is _ALL_NUMBERS:
-            return
-        shown = repr(bad) if len(repr(bad)) <= 40 else repr(bad)[:37] + "..."
-        raise ValueError(f"{name}: must be numbers, got {shown} ({type(bad).__name__})")
-    what = {"b": "true/false (bool)", "U": "text", "S": "bytes"}.get(kind, f"dtype {arr.dtype}")
-    raise ValueError(
-        f"{name}: must be numbers, got {what}; a batch, like a scene file, "
-        "reads numbers only (no units, no booleans)"
-    )
-
-
-def _as_column(columns, name: str):
-    """One input column: a float (a scalar column) or a 1-D float64 array
-    (its length already checked by `row_count`)."""
-    if name not in columns:
-        raise ValueError(f"{name}: missing column")
-    try:
-        arr = np.asarray(columns[name])
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name}: not a numeric column ({exc})") from None
-    _check_numbers(arr, name)
-    arr = arr.astype(np.float64, copy=False)
-    if arr.ndim == 0:
-        return float(arr)
-    if arr.ndim > 1:
-        raise ValueError(f"{name}: must be one-dimensional, got shape {arr.shape}")
-    return arr
 
 
 def run_columns(ks: _kernels.KernelSet, columns, outputs, model: str, everywhere: tuple[str, ...] = ()):
@@ -140,11 +42,11 @@ def run_columns(ks: _kernels.KernelSet, columns, outputs, model: str, everywhere
 
 
 def _run(ks: _kernels.KernelSet, columns, outputs, placeholders) -> dict:
-    """Validate `columns` for kernel `ks`, run it, collect `outputs` (a dict)."""
+    """Normalise each column the kernel reads (once), run it, assemble `outputs`."""
     names = [k for k in ks.inputs if k not in placeholders]
     n = row_count(columns, names)
-    inputs = [0.0 if name in placeholders else _as_column(columns, name) for name in ks.inputs]
-    outs, status, flags = _kernels.run_batch(ks, inputs, n)
+    inputs = [0.0 if name in placeholders else as_column(columns, name) for name in ks.inputs]
+    outs, status, flags = _kernels.run(ks, inputs, n)
     return _collect(ks, outs, status, flags, outputs, n)
 
 
@@ -247,17 +149,12 @@ def _rows(columns: dict, start: int, stop: int) -> dict:
     return {name: column if np.ndim(column) == 0 else column[start:stop] for name, column in columns.items()}
 
 
-def _forward_inputs(model: str) -> tuple[str, ...]:
-    """The columns the forward kernel of a model name reads."""
-    return _kernels.kernel_for(_kernels.preset(model)[0], False).inputs
-
-
 def _check_forward_columns(columns, models) -> None:
     """Every column is read by the batch's model (or, in a mixed batch, by one
     of its models): `check_columns` with the forward kernels' inputs."""
     names = [models] if isinstance(models, str) else sorted(set(models.tolist()))
-    everywhere = tuple(dict.fromkeys(c for family in _kernels.MODELS for c in _forward_inputs(family)))
-    known = tuple(dict.fromkeys(c for name in names for c in _forward_inputs(name))) or everywhere
+    everywhere = _kernels.every_forward_column()
+    known = tuple(dict.fromkeys(c for name in names for c in _kernels.forward_columns(name))) or everywhere
     label = f"the {names[0]} model" if len(names) == 1 else f"the models {', '.join(names)}"
     check_columns(columns, known, label, everywhere)
 
@@ -287,14 +184,12 @@ def _row_models(columns, model):
 
 
 def _solve_group(columns, model: str, critical: bool, names, tier: str, mixed: bool) -> dict:
-    """Rows that share a model and impulse-ratio mode, through one kernel."""
-    family, fixed = _kernels.preset(model)
-    if fixed:
-        columns = _with_fixed(columns, fixed, model, mixed)
+    """Rows that share a model and impulse-ratio mode: plan → run → assemble."""
     critical = critical or _is_critical(columns.get("mu"))
-    placeholders = ("mu",) if critical else ()
-    ks = _kernels.kernel_for(family, critical, _no_moment(columns), tier)
-    return _run(ks, columns, names, placeholders)
+    plan = _kernels.plan(model, critical, _no_moment(columns), tier)
+    if plan.fixed:
+        columns = _with_fixed(columns, plan.fixed, model, mixed)
+    return _run(plan.kernel, columns, names, plan.placeholders)
 
 
 def _is_critical(mu) -> bool:

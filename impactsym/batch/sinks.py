@@ -11,7 +11,7 @@ from __future__ import annotations
 from contextlib import contextmanager
 from pathlib import Path
 
-from ._util import require
+from .._util import require
 
 __all__ = ["SINKS", "sink", "writing", "write_frame"]
 

@@ -3,7 +3,7 @@
 `summary_frame` turns order statistics into the summary DataFrame (one row per
 column, one column per percentile), with numpy.percentile's 'linear'
 arithmetic step by step, so a streamed summary equals numpy's to the bit.
-`InMemory` selects order statistics in memory (`impactsym._selection`); `StreamSummary`
+`InMemory` selects order statistics in memory (`impactsym.batch.selection`); `StreamSummary`
 spills the values of solved rows to files and `OrderStatistics` selects from
 them by radix passes over order-preserving 64-bit keys.
 """
@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .scene import show_value
+from ..scene import show_value
 
 __all__ = [
     "add_counts",
@@ -125,7 +125,7 @@ def percentiles(parts: list[np.ndarray], q: tuple[float, ...], bounds=None) -> n
 
 class InMemory:
     """Order statistics of values held in memory: an array or a list of
-    arrays (`impactsym._selection`: exactly `numpy.partition`'s values)."""
+    arrays (`impactsym.batch.selection`: exactly `numpy.partition`'s values)."""
 
     def __init__(self, values, bounds: tuple[float, float] | None = None):
         self.parts = list(values) if isinstance(values, (list, tuple)) else [values]
@@ -133,7 +133,7 @@ class InMemory:
         self.bounds = bounds
 
     def select(self, ranks: list[int]) -> dict[int, float]:
-        from ._selection import select_ranks
+        from .selection import select_ranks
 
         return select_ranks(self.parts, ranks, self.bounds)
 

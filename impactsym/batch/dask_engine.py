@@ -20,7 +20,7 @@ import itertools
 import os
 from collections.abc import Callable, Iterable, Iterator
 
-from ._util import require
+from .._util import require
 
 __all__ = ["map_chunks", "CHUNKS_PER_THREAD"]
 

@@ -17,10 +17,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _kernels
-from ._util import require
-from .batch import solve_batch
-from .scene import CRITICAL, load_scene, show_value
+from .. import _kernels
+from .._util import require
+from .solve import solve_batch
+from ..scene import CRITICAL, load_scene, show_value
 
 __all__ = [
     "GridPlan",

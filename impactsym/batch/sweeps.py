@@ -9,7 +9,7 @@ generated kernels through `solve_batch`; this module only builds inputs,
 streams results and summarises them.
 
 Before any work, a run that cannot fit is refused with a one-line ValueError
-(`impactsym._resources`): rows held in memory beyond half of the available
+(`impactsym.batch.resources`): rows held in memory beyond half of the available
 memory (use ``out=``), or percentile spill files beyond the free temporary
 space. The spill files live in a temporary folder removed on every way out
 (the end, an error, Ctrl-C; the command line turns SIGTERM into an exit so
@@ -35,9 +35,9 @@ Needs the ``sweep`` extra (pandas, pyarrow, tqdm); ``as_xarray`` the ``xarray``
 extra, ``engine="dask"`` the ``dask`` extra.
 
 This module is the API and runs the chunks; what a chunk computes is in
-`impactsym._plans`, the file writers in `impactsym._sinks`, the exact
-streaming percentiles in `impactsym._quantiles`, and the dask executor in
-`impactsym.dask_engine`.
+`impactsym.batch.plans`, the file writers in `impactsym.batch.sinks`, the exact
+streaming percentiles in `impactsym.batch.quantiles`, and the dask executor in
+`impactsym.batch.dask_engine`.
 """
 
 from __future__ import annotations
@@ -49,13 +49,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ._plans import BLOCK, DISTRIBUTIONS, GridPlan, SamplePlan, check_outputs, frame_of, is_integer
-from ._quantiles import InMemory, StreamSummary, check_q, counts, summary_frame
-from ._resources import check_disk, check_memory
-from ._sinks import sink, write_frame, writing
-from ._util import CHUNK_SIZE, require, spans
+from .plans import BLOCK, DISTRIBUTIONS, GridPlan, SamplePlan, check_outputs, frame_of, is_integer
+from .quantiles import InMemory, StreamSummary, check_q, counts, summary_frame
+from .resources import check_disk, check_memory
+from .sinks import sink, write_frame, writing
+from .._util import CHUNK_SIZE, require, spans
 from .dask_engine import map_chunks
-from .scene import show_value
+from ..scene import show_value
 
 __all__ = [
     "sweep",

@@ -13,7 +13,7 @@ the result is exactly the value `numpy.partition` of the whole would give.
 Values that are not all finite, or fewer than ``SELECT_MIN`` values, go to
 `numpy.partition` of the concatenation (NaN sorts last there, as in numpy).
 
-This module imports numba: it is imported on first use (`impactsym._quantiles`).
+This module imports numba: it is imported on first use (`impactsym.batch.quantiles`).
 """
 
 from __future__ import annotations
