@@ -25,15 +25,6 @@ import numpy as np
 
 from . import _kernels, uncertainty_cli
 from ._version import __version__
-from .codes import describe_status
-from .compare import compare
-from .crash3 import crash3
-from .inverse import invert
-from .plot import add_plot_argument, save_plot
-from .reconstruct import reconstruct
-from .result import UNIT_LABELS, json_clean, json_number, table_cell
-from .scene import SceneError
-from .single import solve
 from .batch.sweeps import (
     CHUNK_SIZE,
     PERCENTILES,
@@ -46,6 +37,15 @@ from .batch.sweeps import (
     write_frame,
 )
 from .batch.sweeps import sweep as solve_sweep
+from .codes import describe_status
+from .compare import compare
+from .crash3 import crash3
+from .inverse import invert
+from .plot import add_plot_argument, save_plot
+from .reconstruct import reconstruct
+from .result import UNIT_LABELS, json_clean, json_number, table_cell
+from .scene import SceneError
+from .single import solve
 
 __all__ = ["COMMANDS", "Command", "build_parser", "main"]
 

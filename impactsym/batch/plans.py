@@ -19,8 +19,8 @@ import numpy as np
 
 from .. import _kernels
 from .._util import require
-from .solve import solve_batch
 from ..scene import CRITICAL, load_scene, show_value
+from .solve import solve_batch
 
 __all__ = [
     "GridPlan",

@@ -49,13 +49,13 @@ from pathlib import Path
 
 import numpy as np
 
+from .._util import CHUNK_SIZE, require, spans
+from ..scene import show_value
+from .dask_engine import map_chunks
 from .plans import BLOCK, DISTRIBUTIONS, GridPlan, SamplePlan, check_outputs, frame_of, is_integer
 from .quantiles import InMemory, StreamSummary, check_q, counts, summary_frame
 from .resources import check_disk, check_memory
 from .sinks import sink, write_frame, writing
-from .._util import CHUNK_SIZE, require, spans
-from .dask_engine import map_chunks
-from ..scene import show_value
 
 __all__ = [
     "sweep",
