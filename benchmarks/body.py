@@ -27,6 +27,7 @@ import numba
 import numpy as np
 
 from impactsym import _kernels
+from impactsym._kernels import runner
 
 from .performance import SEED, approaching_scenes, build_cases
 
@@ -44,11 +45,11 @@ def add_arguments(parser) -> None:
 def _case_runner(case, rows: int):
     """A zero-argument call of a case's parallel driver on preallocated outputs."""
     ks = _kernels.kernel_for(*case.kernel)
-    inputs = [_kernels._as_input(x) for x in case.inputs()]
-    columns, normal = _kernels._columns_for(ks, inputs, rows)
+    inputs = [_kernels.as_input(x) for x in case.inputs()]
+    columns = runner._driver_columns(ks, inputs)
     columns = [c if isinstance(c, np.ndarray) else np.full(rows, c) for c in columns]
     outs = [np.empty(rows) for _ in ks.outputs] + [np.empty(rows, np.int32), np.empty(rows, np.int32)]
-    driver = ks.driver(True, normal)
+    driver = ks.driver
     return lambda: driver(*columns, *outs)
 
 
@@ -113,7 +114,6 @@ def _time(runs: dict, rows: int, rounds: int) -> dict:
 
 
 def main(args) -> int:
-    _kernels.PYTHON_BELOW = 0
     if args.against:
         old = subprocess.run(
             ["git", "show", f"{args.against}:generated/planar_jit.py"],

@@ -26,9 +26,9 @@ user would write, start-up times, the serial/parallel threshold and a large swee
    never made before (three scalar/array mixes of ``solve_batch``, one ``sweep``,
    ``sample`` small and large, ``invert_batch``, ``reconstruct_batch``; ``WAIT_CALLS``):
    the wait of the first run over the least of three later runs in the same process.
-4. **Serial threshold.** Serial twin against parallel driver for n = 1, 2, 4, ..., 4096,
-   called directly (preallocated outputs) and through ``run_batch`` (its SERIAL_BELOW
-   forced to always-serial / always-parallel); per n the median of many interleaved calls.
+4. **Small batches.** The one driver on one thread (numba.set_num_threads(1)) against all
+   threads for n = 1, 2, 4, ..., 4096, called directly (preallocated outputs) and through
+   ``run_batch``; per n the median of many interleaved calls.
 5. **Sweep.** ``impactsym sweep`` of ``--sweep-points`` rows (e x mu grid) writing a
    Parquet file to a temporary folder: wall time, rows/s, peak RSS of the child
    (``os.wait4``). On by default when ``impactsym.sweep`` exists (``--no-sweep``).
@@ -290,7 +290,7 @@ class Case:
         """The parallel driver run_batch calls for these columns (normal form for a
         scalar angle)."""
         ks = _kernels.kernel_for(*self.kernel)
-        return ks.batch if isinstance(self.columns["gamma"], np.ndarray) else ks.batch_normal
+        return _kernels.kernel_for(*self.kernel).driver
 
     def median_ns(self, what: str) -> float:
         return float(np.median(self.times[what]))
@@ -567,8 +567,7 @@ for _ in range(4):
     t0 = time.perf_counter()
     call()
     times.append(time.perf_counter() - t0)
-# steady: the least of the later calls (a small batch may run in Python at first and
-# load the numba drivers in a later call: impactsym._kernels.PYTHON_BELOW)
+# steady: the least of the later calls
 print(json.dumps({"first_s": times[0], "steady_s": min(times[1:])}))
 """
 
@@ -653,10 +652,9 @@ def time_compile_waits(columns: dict, quiet: Quiet, runs: int = STARTUP_RUNS) ->
             )
             return json.loads(done.stdout.splitlines()[-1])
 
-        # The package's first use (warm cache for case (a)); its background compile of
-        # every other driver (impactsym.warmup) is run here in the foreground instead, and
-        # timed, so the waits below are measured after it finished, as a user meets them.
-        quiet_env = {**os.environ, "IMPACTSYM_BACKGROUND_COMPILE": "0"}
+        # The package's first use (warm cache for case (a)), then `impactsym compile` of
+        # every other driver, timed; the waits below are measured after it.
+        quiet_env = dict(os.environ)
         child(_FIRST_CALL, str(path), env=quiet_env)
         t0 = time.perf_counter()
         subprocess.run(
@@ -786,41 +784,47 @@ def _median_call_ns(calls: dict, repeat: int) -> dict:
 
 
 def _threshold_calls(columns: dict, n: int) -> dict:
-    """Serial and parallel rigid drivers on ``n`` rows: called directly with preallocated
-    outputs, and through run_batch with SERIAL_BELOW forced (see time_threshold)."""
+    """The one rigid driver (a prange loop) on ``n`` rows, on one thread ("serial":
+    numba.set_num_threads(1) around the call, the cost a serial twin would have) and on
+    all ("parallel"): called directly with preallocated outputs, and through run_batch."""
+    import numba
+
+    from impactsym._kernels import runner
+
     ks = _kernels.kernel_for("rigid", False)
     inputs = [np.ascontiguousarray(columns[k][:n]) for k in ks.inputs]
+    driven = runner._driver_columns(ks, inputs)
     outs = [np.empty(n) for _ in ks.outputs] + [np.empty(n, dtype=np.int32) for _ in range(2)]
+    threads = numba.get_num_threads()
 
-    def through_run_batch(serial_below):
-        def call():
-            _kernels.SERIAL_BELOW = serial_below
-            _kernels.run_batch(ks, inputs, n)
+    def one_thread(call):
+        def run():
+            numba.set_num_threads(1)
+            try:
+                call()
+            finally:
+                numba.set_num_threads(threads)
 
-        return call
+        return run
 
     return {
-        "serial": lambda: ks.serial(*inputs, *outs),
-        "parallel": lambda: ks.batch(*inputs, *outs),
-        "run_batch serial": through_run_batch(n + 1),
-        "run_batch parallel": through_run_batch(0),
+        "serial": one_thread(lambda: ks.driver(*driven, *outs)),
+        "parallel": lambda: ks.driver(*driven, *outs),
+        "run_batch serial": one_thread(lambda: _kernels.run_batch(ks, inputs, n)),
+        "run_batch parallel": lambda: _kernels.run_batch(ks, inputs, n),
     }
 
 
 def time_threshold(columns: dict, repeat: int) -> dict:
-    """Median ns per call of each way, by n in THRESHOLD_SIZES (run_batch's
-    SERIAL_BELOW is restored afterwards). Short: run it as one quiet-gated block."""
-    saved = _kernels.SERIAL_BELOW
-    try:
-        table = {}
-        for n in THRESHOLD_SIZES:
-            calls = _threshold_calls(columns, n)
-            for call in calls.values():
-                call()
-            table[n] = _median_call_ns(calls, repeat)
-        return table
-    finally:
-        _kernels.SERIAL_BELOW = saved
+    """Median ns per call of each way, by n in THRESHOLD_SIZES. Short: run it as one
+    quiet-gated block."""
+    table = {}
+    for n in THRESHOLD_SIZES:
+        calls = _threshold_calls(columns, n)
+        for call in calls.values():
+            call()
+        table[n] = _median_call_ns(calls, repeat)
+    return table
 
 
 def crossover(table: dict, serial: str, parallel: str) -> int | None:
@@ -1221,15 +1225,12 @@ def markdown(
         "### Compile waits after first use (fresh processes)",
         "",
         "The package's first use: one `solve_batch` on case (a) (every column an array, "
-        "an angle per row) in its own process, then the compile of every other batch "
-        "driver that the first use starts in the background (`impactsym compile`, timed "
-        f"here in the foreground: {start['waits']['warmup_s']:.0f} s; it loads what is "
-        "cached already). Then each call below, never made before, "
+        "an angle per row) in its own process, then `impactsym compile` of every other "
+        f"batch driver ({start['waits']['warmup_s']:.0f} s; it loads what is cached "
+        "already). Then each call below, never made before, "
         f"in {start['waits']['runs']} fresh processes: wait = first run − the least of three "
-        "later runs of the call in the process (loading, or compiling, the drivers it needs; "
-        "a batch within the process's first 10,000 rows runs the per-scene functions "
-        "instead, `impactsym._kernels.PYTHON_BELOW`, and loads nothing). *first*: the very "
-        "first process; *min*: least over the processes.",
+        "later runs of the call in the process (loading the drivers it needs). *first*: the "
+        "very first process; *min*: least over the processes.",
         "",
         "| call | what | first wait s | min wait s | steady s | target |",
         "|---|---|---:|---:|---:|---:|",
@@ -1241,7 +1242,10 @@ def markdown(
         )
     lines += [
         "",
-        "## 4. Serial threshold (rigid, all outputs; median µs per call)",
+        "## 4. Small batches: one thread or all (rigid, all outputs; median µs per call)",
+        "",
+        "*serial*: the driver with numba.set_num_threads(1) around the call; *parallel*: "
+        "on all threads, as the runtime runs every batch.",
         "",
         "| n | serial | parallel | run_batch serial | run_batch parallel |",
         "|---:|---:|---:|---:|---:|",
@@ -1285,7 +1289,7 @@ def threshold_verdict(table: dict, tolerance: float = 0.05) -> str:
     when that is within ``tolerance``)."""
     direct = crossover(table, "serial", "parallel")
     runtime = crossover(table, "run_batch serial", "run_batch parallel")
-    current = _kernels.SERIAL_BELOW
+    current = 0  # the runtime runs every batch on all threads
     cost, worst = max(
         (
             row["run_batch serial" if n < current else "run_batch parallel"]
@@ -1305,7 +1309,7 @@ def threshold_verdict(table: dict, tolerance: float = 0.05) -> str:
     text = (
         f"Crossover (smallest n from which parallel is faster at every larger n measured; "
         f"n doubles, so it is known to a factor 2): direct {says(direct)}, through run_batch "
-        f"{says(runtime)}. SERIAL_BELOW = {current} "
+        f"{says(runtime)}. All threads at every n (no serial twin) "
         + (
             f"costs at most {cost:.1%} over the faster way at any measured n (n = {worst}): "
             if cost > 0
@@ -1318,8 +1322,8 @@ def threshold_verdict(table: dict, tolerance: float = 0.05) -> str:
     else:
         text += f"the measurement suggests {suggested}."
     return text + (
-        f" At n = {min(table)} a prange launch costs {launch / 1e3:.1f} µs "
-        f"(parallel − serial) and run_batch's own work {overhead / 1e3:.1f} µs "
+        f" At n = {min(table)} a launch on all threads costs {launch / 1e3:.1f} µs "
+        f"more than on one (parallel − serial) and run_batch's own work {overhead / 1e3:.1f} µs "
         "(allocation, argument handling)."
     )
 
@@ -1499,7 +1503,6 @@ def main(args) -> int:
         "startup": start,
         "serial_threshold": {
             "table_ns": {str(k): v for k, v in table.items()},
-            "serial_below": _kernels.SERIAL_BELOW,
             "verdict": thresh["verdict"],
         },
         "sweep": sweep,

@@ -131,8 +131,8 @@ def jacobian_vs_value() -> dict:
     point, reps = FORWARD, REPS
     for name, value_ks, values in (
         ("reconstruct", _kernels.RECONSTRUCT, SCENE),
-        ("rigid", _kernels.KERNELS[("rigid", False, False, "energy")], point),
-        ("particle", _kernels.KERNELS[("particle", False, False, "energy")], point),
+        ("rigid", _kernels.kernel_for("rigid", False), point),
+        ("particle", _kernels.kernel_for("particle", False), point),
     ):
         jac = _kernels.JACOBIAN[name]
         t_jac = (
