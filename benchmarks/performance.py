@@ -287,9 +287,7 @@ class Case:
         return lambda: _kernels.run_batch(ks, inputs, n)
 
     def driver(self):
-        """The parallel driver run_batch calls for these columns (normal form for a
-        scalar angle)."""
-        ks = _kernels.kernel_for(*self.kernel)
+        """The driver run_batch calls for these columns (the kernel's one driver)."""
         return _kernels.kernel_for(*self.kernel).driver
 
     def median_ns(self, what: str) -> float:

@@ -320,7 +320,7 @@ def _lines(prog: Program, ind: str, style: Style, straight: bool) -> list[str]:
             for flag, conds in step[1]:
                 if straight:
                     # The bit times the condition, not `if`: LLVM kept an `if`
-                    # on e (E_OUT_OF_RANGE) as a costlier select, 4 ns a row.
+                    # on e (E_OUT_OF_RANGE) as a costlier select (docs/kernels.md).
                     cond = " | ".join(f"({c})" for c in conds)
                     lines.append(f"{ind}flags |= {FLAGS[flag]} * ({cond})  # {flag}")
                 else:

@@ -22,28 +22,7 @@ from .result import UNIT_LABELS, json_number, road_speed_rows, table_cell, witho
 from .scene import Scene, SceneError, load_scene
 from .single import overflow_error
 
-OUTPUTS = (
-    "s1",
-    "s2",
-    "v1x",
-    "v1y",
-    "v2x",
-    "v2y",
-    "Pn",
-    "Pt",
-    "M",
-    "M_residual",
-    "e",
-    "mu",
-    "e_m",
-    "mu_c",
-    "TL",
-    "TLn",
-    "TLt",
-    "TLm",
-    "pdof1",
-    "pdof2",
-)
+OUTPUTS = _kernels.FAMILY_OUTPUTS["reconstruct"]
 
 
 def reconstruct_batch(columns):

@@ -16,6 +16,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import impactsym
+from impactsym import _kernels
 from impactsym.cli import main
 
 sweeps = importlib.import_module("impactsym.batch.sweeps")
@@ -25,25 +26,7 @@ ROOT = Path(__file__).resolve().parents[1]
 US = ROOT / "examples" / "two_car_us.json"  # rigid, mu = 0.3
 SI = ROOT / "examples" / "intersection_si.toml"  # rigid, mu = "critical"
 US_SCENE = json.loads(US.read_text())
-OUTPUTS = (
-    "V1x",
-    "V1y",
-    "W1",
-    "V2x",
-    "V2y",
-    "W2",
-    "Pn",
-    "Pt",
-    "M",
-    "mu",
-    "mu_c",
-    "dV1",
-    "dV2",
-    "TL",
-    "TLn",
-    "TLt",
-    "TLm",
-)
+OUTPUTS = _kernels.OUTPUTS
 DISTS = {
     "e": ("uniform", 0.0, 0.3),
     "mu": ("normal", 0.2, 0.05),

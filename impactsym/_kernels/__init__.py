@@ -31,6 +31,7 @@ from .runner import as_input, run, run_batch, run_one
 __all__ = [
     "CODES",
     "COEFFICIENT_INPUTS",
+    "FAMILY_OUTPUTS",
     "PRESETS",
     "KernelSet",
     "as_input",
