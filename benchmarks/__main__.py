@@ -13,6 +13,7 @@ import sys
 SUBCOMMANDS = {
     "accuracy": "benchmarks.accuracy",
     "body": "benchmarks.body",
+    "drivers": "benchmarks.drivers",
     "inverse": "benchmarks.inverse",
     "performance": "benchmarks.performance",
     "uncertainty": "benchmarks.uncertainty",
