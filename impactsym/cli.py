@@ -479,7 +479,7 @@ def _add_validate(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_validate(args: argparse.Namespace) -> int:
-    """The models against RICSAC, IIHS and NHTSA crash tests (impactsym/validation.py)."""
+    """The models against RICSAC, IIHS and NHTSA crash tests (impactsym.validation)."""
     from . import validation
 
     datasets = validation.report()

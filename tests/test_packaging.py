@@ -22,7 +22,6 @@ SDIST_DIRS = (
     "benchmarks",
     "examples",
     "notebooks",
-    "validation",
 )
 
 
