@@ -74,11 +74,12 @@ from typing import Any
 
 from . import _kernels
 from ._kernels import FLAG_PDOF_CAPPED
-from .casefile import check_keys
 from .codes import describe_status
 from .crash3_tables import CLASSES, FACES, class_dimensions, stiffness
 from .result import UNIT_LABELS, road_speed_rows
-from .scene import Scene, SceneError, Vehicle, _mapping, _number, _positive, load_scene, scene_data
+from .scene import Scene, SceneError, Vehicle, load_scene, scene_data
+from .scene.casefile import check_keys
+from .scene.fields import as_mapping, as_number, as_positive
 from .single import solve
 
 __all__ = [
@@ -330,7 +331,7 @@ def crash3_options(
 
 def _options(data: Mapping, restitution, energy, correction) -> Crash3Options:
     """The scene's ``"crash3"`` options overridden by the arguments given (not None)."""
-    table = _mapping(data.get("crash3", {}), "crash3")
+    table = as_mapping(data.get("crash3", {}), "crash3")
     for key in table:
         if key not in OPTION_KEYS:
             raise SceneError(f"unknown CRASH3 option (use {', '.join(OPTION_KEYS)})", f"crash3.{key}")
@@ -359,7 +360,7 @@ def _restitution(value: Any, path: str = "restitution", energy: str = "dissipate
     dissipate nothing), 0 ≤ e ≤ 1 when it is absorbed to maximum crush."""
     if value is None:
         return 0.0
-    e = _number(value, path)
+    e = as_number(value, path)
     if energy == "dissipated" and not 0.0 <= e < 1.0:
         raise SceneError(f"must be in [0, 1) when the crush energy is dissipated, got {e:g}", path)
     if not 0.0 <= e <= 1.0:
@@ -370,7 +371,7 @@ def _restitution(value: Any, path: str = "restitution", energy: str = "dissipate
 def _parse_crush(raw: Any, path: str, units: str = "SI") -> Crush:
     """Validate a ``crush`` table; each bad entry is an error naming its field and
     the rule it breaks (the kernels check the ranges again)."""
-    data = _mapping(raw, path)
+    data = as_mapping(raw, path)
     for key in ("width", "depths", "pdof"):
         if key not in data:
             raise SceneError("missing", f"{path}.{key}")
@@ -378,14 +379,14 @@ def _parse_crush(raw: Any, path: str, units: str = "SI") -> Crush:
     depths = data["depths"]
     if not isinstance(depths, list) or len(depths) not in PROFILE_SIZES:
         raise SceneError(f"must be a list of 2, 4 or 6 crush depths, got {_short(depths)}", f"{path}.depths")
-    crush_depths = tuple(_number(c, f"{path}.depths[{i}]") for i, c in enumerate(depths))
+    crush_depths = tuple(as_number(c, f"{path}.depths[{i}]") for i, c in enumerate(depths))
     for i, c in enumerate(crush_depths):
         if c < 0.0:
             raise SceneError(f"must be >= 0 (a crush depth), got {c:g}", f"{path}.depths[{i}]")
-    width = _number(data["width"], f"{path}.width")
+    width = as_number(data["width"], f"{path}.width")
     if width <= 0.0:
         raise SceneError(f"must be > 0 (the damage width), got {width:g}", f"{path}.width")
-    pdof = _number(data["pdof"], f"{path}.pdof")
+    pdof = as_number(data["pdof"], f"{path}.pdof")
     if abs(pdof) >= PDOF_LIMIT_DEG:
         raise SceneError(
             f"|pdof| = {abs(pdof):g} must be < {PDOF_LIMIT_DEG:g} degrees from the "
@@ -394,9 +395,9 @@ def _parse_crush(raw: Any, path: str, units: str = "SI") -> Crush:
         )
     optional = {}
     if "moment_arm" in data:
-        optional["moment_arm"] = _number(data["moment_arm"], f"{path}.moment_arm")
+        optional["moment_arm"] = as_number(data["moment_arm"], f"{path}.moment_arm")
     if "radius_of_gyration" in data:
-        optional["radius_of_gyration"] = _positive(data["radius_of_gyration"], f"{path}.radius_of_gyration")
+        optional["radius_of_gyration"] = as_positive(data["radius_of_gyration"], f"{path}.radius_of_gyration")
     if "class" in data:
         if data["class"] not in CLASSES:
             raise SceneError(
@@ -432,7 +433,7 @@ def _stiffness(data: Mapping, path: str, units: str) -> tuple[float, float]:
     for key in ("A", "B"):
         if key not in data:
             raise SceneError("missing (give A and B, or category and face)", f"{path}.{key}")
-    a, b = _number(data["A"], f"{path}.A"), _number(data["B"], f"{path}.B")
+    a, b = as_number(data["A"], f"{path}.A"), as_number(data["B"], f"{path}.B")
     if a < 0.0:
         raise SceneError(f"must be >= 0 (the force per unit width at zero crush), got {a:g}", f"{path}.A")
     if b <= 0.0:

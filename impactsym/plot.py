@@ -74,7 +74,8 @@ from .crash3 import Crash3Result
 from .plot_crash3 import save_crash3
 from .plot_sweep import save_sweep, sweep
 from .result import UNIT_LABELS
-from .scene import Scene, SceneError, _read_file, load_scene
+from .scene import Scene, SceneError, load_scene
+from .scene.reader import read_file
 
 __all__ = [
     "scene",
@@ -297,7 +298,7 @@ def _impact_position(source: SceneLike) -> tuple[float, float]:
             position = source.extra.get("impact_position")
         if position is None and source.source is not None:
             try:
-                raw = _read_file(source.source)
+                raw = read_file(source.source)
             except (OSError, SceneError):
                 raw = None
             position = _raw_position(raw)
@@ -305,7 +306,7 @@ def _impact_position(source: SceneLike) -> tuple[float, float]:
         position = _raw_position(source)
     else:
         try:
-            position = _raw_position(_read_file(Path(source)))
+            position = _raw_position(read_file(Path(source)))
         except (OSError, SceneError):
             position = None
     if position is None:
