@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _kernels, uncertainty_cli, warmup
+from . import _kernels, warmup
 from ._version import __version__
 from .codes import describe_status
 from .compare import compare
@@ -46,6 +46,7 @@ from .sweep import (
     write_frame,
 )
 from .sweep import sweep as solve_sweep
+from .uncertainty import cli as uncertainty_cli
 
 __all__ = ["COMMANDS", "Command", "build_parser", "main"]
 

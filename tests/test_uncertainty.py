@@ -19,8 +19,8 @@ import pytest
 from mpmath import mp
 
 from impactsym import _kernels, solve_batch
-from impactsym import propagation as U
 from impactsym.testing import reference
+from impactsym.uncertainty import propagation as U
 
 SCENE = {
     "m1": 1500.0,

@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from impactsym import propagation as U
+from impactsym.uncertainty import propagation as U
 
 DATA = Path(__file__).resolve().parents[1] / "impactsym" / "data" / "validation" / "ricsac8_crash3.csv"
 PDOF_DEG = -20.5

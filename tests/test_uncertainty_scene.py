@@ -96,7 +96,7 @@ def test_every_numeric_output_has_an_entry(tmp_path, command, name, edit):
 
 
 def test_api_reconstruction_speeds_and_plot(tmp_path):
-    from impactsym.uncertainty_plot import save_uncertainty_plot
+    from impactsym.uncertainty.plot import save_uncertainty_plot
 
     u = impactsym.uncertainty(
         EXAMPLES / "reconstruct_intersection_uncertain.json", command="reconstruct", draws=20_000, seed=3

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from ._quantiles import percentiles
+from .._quantiles import percentiles
 
 __all__ = ["Uncertainty", "Stats", "KEEP", "HISTOGRAM_BINS", "PERCENTILES"]
 
