@@ -626,7 +626,7 @@ def _short(value: Any) -> str:
 
 def crush_tables(scene: Scene | Mapping | str | Path) -> tuple[Crush | None, ...]:
     """Each vehicle's validated ``crush`` table (None for a fixed body), as
-    :func:`crash3` reads them (for the CRASH3 diagram of :mod:`impactsym.plot_crash3`)."""
+    :func:`crash3` reads them (for the CRASH3 diagram of :mod:`impactsym.pictures.crash3`)."""
     parsed = load_scene(scene_data(scene), kind="crash3")
     return tuple(
         None if v.fixed else _parse_crush(v.extra["crush"], f"vehicles[{i}].crush", parsed.units)

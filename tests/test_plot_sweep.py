@@ -15,7 +15,8 @@ import pandas as pd
 import pytest
 
 import impactsym
-from impactsym import plot, plot_sweep
+from impactsym import plot
+from impactsym.pictures import sweep as plot_sweep
 
 matplotlib.use("Agg")
 SCENE = Path(__file__).resolve().parent.parent / "examples" / "intersection_si.toml"
