@@ -20,7 +20,7 @@ import pytest
 
 import impactsym
 from impactsym.cli import main
-from impactsym.crash3_tables import class_dimensions, stiffness
+from impactsym.crash3.tables import class_dimensions, stiffness
 from impactsym.scene import SceneError
 
 ROOT = Path(__file__).resolve().parents[1]

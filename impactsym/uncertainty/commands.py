@@ -170,7 +170,7 @@ def _crash3_stages(c: Mapping, options, units: str, tangents: list | None = None
     energy. With `tangents` (per input, d column) the exact Jacobian kernels
     of each stage carry them through too (one scene). Returns (values by
     name, status, per-input tangents by name)."""
-    from ..crash3 import CORRECTED_OUTPUT, DELTA_V_KERNELS, ENERGY_FACTOR
+    from ..crash3.model import CORRECTED_OUTPUT, DELTA_V_KERNELS, ENERGY_FACTOR
 
     factor = ENERGY_FACTOR[units]
     corrected = CORRECTED_OUTPUT[options.correction]
