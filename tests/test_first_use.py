@@ -520,7 +520,7 @@ def test_a_signal_inside_llvmlites_object_cache_hook_is_sent_again_not_lost():
     # handler's test runs inside it (from a profile hook).
     from llvmlite.binding import executionengine
 
-    from impactsym import cli
+    from impactsym.cli import signals
 
     class Engine:
         _object_cache_notify = None  # the hook returns at once
@@ -530,7 +530,7 @@ def test_a_signal_inside_llvmlites_object_cache_hook_is_sent_again_not_lost():
 
     def profiler(frame, event, arg):
         if event == "call" and frame.f_code is hook:
-            inside.append(cli._deferred(signal.SIGUSR1, frame))
+            inside.append(signals._deferred(signal.SIGUSR1, frame))
 
     received = []
     previous = signal.signal(signal.SIGUSR1, lambda signum, frame: received.append(signum))
@@ -553,7 +553,7 @@ def test_a_signal_inside_a_finaliser_is_sent_again_not_lost():
     # Python drops an exception raised in __del__ (numba and llvmlite free compiler
     # objects there), so a Ctrl-C landing there would be lost: the CLI's handler
     # leaves it and sends the signal again once the finaliser has returned.
-    from impactsym import cli
+    from impactsym.cli import signals
 
     received = []
     previous = signal.signal(signal.SIGUSR1, lambda signum, frame: received.append(signum))
@@ -561,11 +561,11 @@ def test_a_signal_inside_a_finaliser_is_sent_again_not_lost():
 
         class Finalised:
             def __del__(self):
-                received.append(cli._deferred(signal.SIGUSR1, sys._getframe()))
+                received.append(signals._deferred(signal.SIGUSR1, sys._getframe()))
 
         Finalised()  # finalised at once (no other reference)
         assert received == [True]
-        assert cli._deferred(signal.SIGUSR1, sys._getframe()) is False
+        assert signals._deferred(signal.SIGUSR1, sys._getframe()) is False
         deadline = time.monotonic() + 5
         while len(received) < 2 and time.monotonic() < deadline:
             time.sleep(0.01)
