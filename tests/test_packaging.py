@@ -98,8 +98,12 @@ def test_the_wheel_ships_the_validation_data_once_and_no_test_dependency(dists):
     assert len([n for n in names if n.endswith(".csv")]) == len(shipped)  # no table twice
     for name in (n for n in names if n.endswith(".py")):
         tree = ast.parse(archive.read(name), name)
-        imported = {alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names}
-        imported |= {node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom) and node.module}
+        imported = {
+            alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names
+        }
+        imported |= {
+            node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom) and node.module
+        }
         assert not {m.split(".")[0] for m in imported} & {"mpmath", "pytest", "hypothesis"}, name
 
 
@@ -169,7 +173,15 @@ WHOLE_PACKAGE_RUNS = [
     ["solve", "intersection_si.toml", "--plot", "scene.png"],
     ["invert", "invert_two_car_si.json"],
     ["reconstruct", "reconstruct_intersection_us_casefile.json"],
-    ["reconstruct", "reconstruct_intersection_uncertain.json", "--uncertainty", "--draws", "2000", "--seed", "1"],
+    [
+        "reconstruct",
+        "reconstruct_intersection_uncertain.json",
+        "--uncertainty",
+        "--draws",
+        "2000",
+        "--seed",
+        "1",
+    ],
     ["crash3", "crash3_two_car_us.json", "--json"],
     ["compare", "models_two_car_us.json"],
     ["sweep", "two_car_us.json", "--vary", "e=0:0.3:4", "--vary", "mu=0:0.5:3", "--no-progress"],
