@@ -7,7 +7,6 @@ answer (exit 2, the field named) or the quiet behaviour the issue asks for.
 import dataclasses
 import json
 import math
-import os
 import re
 import signal
 import subprocess
@@ -20,30 +19,19 @@ import pandas as pd
 import pytest
 
 import impactsym
-from impactsym.cli import COMMANDS, main
+from impactsym.cli import COMMANDS
 from impactsym.codes import FLAG_E_OUT_OF_RANGE
 from impactsym.reconstruct import moment_warnings
 from impactsym.result import json_number, without_residue
 from impactsym.scene import load_scene
+from tests.helpers import cli_argv as _cli
+from tests.helpers import cli_env as _env
+from tests.helpers import one_line_error
+from tests.helpers import run_cli as run
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 SCENE = json.loads((EXAMPLES / "two_car_us.json").read_text())
-
-
-def run(capsys, *argv):
-    """Run ``impactsym`` in-process; return (exit code, stdout, stderr)."""
-    code = main([str(arg) for arg in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def one_line_error(capsys, *argv) -> str:
-    """The stderr line of a command that must fail with exit 2 and print nothing else."""
-    code, out, err = run(capsys, *argv)
-    assert code == 2, (code, out, err)
-    assert out == "" and err.count("\n") == 1 and err.startswith("impactsym: error: "), err
-    return err
 
 
 # --------------------------------------------------------------------------- 1. scene files
@@ -301,15 +289,6 @@ def test_residue_is_judged_against_the_scale_of_its_unit():
 
 
 # --------------------------------------------------------------------------- 5. the command line
-
-
-def _cli(*argv) -> list[str]:
-    """The command line of ``impactsym`` in a subprocess of this checkout."""
-    return [sys.executable, "-m", "impactsym", *map(str, argv)]
-
-
-def _env(**extra) -> dict:
-    return {**os.environ, "PYTHONPATH": str(ROOT), **extra}
 
 
 def test_a_plot_error_names_the_option_once(capsys):

@@ -16,7 +16,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import impactsym
-from impactsym.cli import main
+from tests.helpers import run_cli as run
 
 sweeps = importlib.import_module("impactsym.sweep")  # impactsym.sweep is the function
 quantiles = importlib.import_module("impactsym._quantiles")
@@ -507,12 +507,6 @@ def test_progress_by_default_only_on_a_terminal_for_large_work(monkeypatch, caps
 
 
 # --------------------------------------------------------------------------- command line
-
-
-def run(capsys, *argv):
-    code = main([str(arg) for arg in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def test_cli_sweep_prints_a_summary(capsys):
