@@ -139,7 +139,7 @@ def save_plot(
     The format follows the suffix (``.png``, ``.svg``, ``.pdf``, ...). Uses a
     plain Agg canvas (no pyplot, no display needed). Returns the path. A
     CRASH3 result (:func:`impactsym.crash3`, with ``scene=``) is drawn as its
-    CRASH3 diagram (:mod:`impactsym.plot_crash3`).
+    CRASH3 diagram (:mod:`impactsym.pictures.crash3`).
     Raises :class:`ImportError` (with the install command) without matplotlib
     and :class:`OSError` when the file cannot be written.
     """
