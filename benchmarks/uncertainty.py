@@ -77,7 +77,7 @@ UNCERTAIN = {
 
 def source():
     """A column-level reconstruction with eight normal inputs (named by column)."""
-    from impactsym import propagation as U
+    from impactsym.uncertainty import propagation as U
 
     inputs = tuple(U.Input(k, "normal", (SCENE[k], sd)) for k, sd in UNCERTAIN.items())
 
@@ -98,7 +98,7 @@ def _best(func, repeat: int = 3) -> float:
 
 
 def end_to_end(draws: int) -> dict:
-    from impactsym import propagation as U
+    from impactsym.uncertainty import propagation as U
     from impactsym import reconstruct_batch
 
     src = source()
@@ -155,7 +155,7 @@ def jacobian_vs_value() -> dict:
 CHILD = """
 import resource, sys, time
 from benchmarks.uncertainty import source
-from impactsym import propagation as U
+from impactsym.uncertainty import propagation as U
 start = time.perf_counter()
 r = U.propagate(source(), draws={draws}, seed=3)
 print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, time.perf_counter() - start,

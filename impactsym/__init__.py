@@ -25,11 +25,11 @@ from .crash3 import crash3
 from .energy import delta_v_from_energy
 from .explore import explore
 from .inverse import invert, invert_batch
-from .propagation import uncertainty
 from .reconstruct import reconstruct, reconstruct_batch
 from .result import Result
 from .scene import MODELS, Impact, Scene, SceneError, Vehicle, load_scene
 from .single import solve
+from .uncertainty import uncertainty
 
 __all__ = [
     "FLAG_MESSAGES",

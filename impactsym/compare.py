@@ -36,7 +36,8 @@ from ._kernels import PRESETS
 from ._util import require
 from .crash3 import crash3
 from .result import UNIT_LABELS, Result
-from .scene import Scene, SceneError, _mapping, load_scene, scene_data, uses_yaw
+from .scene import Scene, SceneError, load_scene, scene_data, uses_yaw
+from .scene.fields import as_mapping
 from .single import solve
 
 __all__ = ["compare", "Comparison", "ModelRow", "COMPARED_MODELS"]
@@ -332,7 +333,7 @@ def _variant(data: Mapping, model: str) -> dict:
     fixes or does not use are left out (so they raise no warnings)."""
     preset = PRESETS[model]
     used = ("normal_angle", *preset["required"], *preset["optional"])
-    impact = {k: v for k, v in _mapping(data.get("impact", {}), "impact").items() if k in used}
+    impact = {k: v for k, v in as_mapping(data.get("impact", {}), "impact").items() if k in used}
     return {**data, "model": model, "impact": impact}
 
 

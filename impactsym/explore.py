@@ -73,9 +73,9 @@ class Explorer:
         from matplotlib.backends.backend_agg import FigureCanvasAgg
         from matplotlib.figure import Figure
 
-        from . import plot
+        from .pictures import diagram, labels
 
-        self._plot = plot
+        self._diagram, self._labels = diagram, labels
         self.scene = load_scene(scene)
         if self.scene.source is not None:
             self.name = self.scene.source.name
@@ -355,16 +355,16 @@ class Explorer:
         source: Any = data if self.result is None else self.result
         options = {"scene": data} if self.result is not None else {}
         if self._velocity_scale is None:
-            self._velocity_scale = self._plot.default_velocity_scale(source, **options)
+            self._velocity_scale = self._diagram.default_velocity_scale(source, **options)
         # no title on the picture: the header and readout carry it (a title costs ~7 ms to draw)
-        handles, legend_title = self._plot._render(
+        handles, legend_title = self._diagram.render(
             ax, source, velocity_scale=self._velocity_scale, title="", **options
         )
         limits = (ax.get_xlim(), ax.get_ylim())
         limits = _grown(self._limits, limits)
         ax.set_xlim(*limits[0])
         ax.set_ylim(*limits[1])
-        self._plot._place_labels(ax)  # now that the limits are final
+        self._labels.place_labels(ax)  # now that the limits are final
         dynamic = sorted(
             [*ax.patches, *ax.lines, *ax.texts, ax.title], key=lambda artist: artist.get_zorder()
         )
@@ -372,7 +372,7 @@ class Explorer:
             artist.set_animated(True)
         key = (limits, legend_title, tuple(handle.get_label() for handle in handles))
         if self._background is None or key != self._background_key:
-            self._plot._legend(ax, handles, legend_title)
+            self._diagram.add_legend(ax, handles, legend_title)
             canvas.draw()  # everything but the animated (scene) artists
             self._background, self._background_key = canvas.copy_from_bbox(self._figure.bbox), key
             self._full_redraws += 1

@@ -107,7 +107,9 @@ def test_the_walk_sees_every_kind_of_import():
     } <= set(MODULES)
     assert "impactsym._kernels" in IMPORTS["impactsym.batch.solve"]  # from .. import _kernels
     assert "impactsym.batch" in IMPORTS["impactsym"]  # from .batch import solve_batch
-    assert "impactsym.plot" in IMPORTS["impactsym.explore"]  # function-level from . import plot
+    assert (
+        "impactsym.pictures.diagram" in IMPORTS["impactsym.explore"]
+    )  # function-level from .pictures import diagram
     assert "impactsym.testing.reference" in IMPORTS["impactsym.testing.scenes"]
 
 

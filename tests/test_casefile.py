@@ -18,8 +18,8 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 import impactsym
-from impactsym.cli import main
 from impactsym.scene import SceneError, load_scene, scene_columns
+from tests.helpers import run_cli as run
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
@@ -51,24 +51,18 @@ PLAIN = {
 }
 
 
-def run(capsys, *argv):
-    code = main([str(arg) for arg in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
 # --------------------------------------------------------------------------- published examples
 
 # Rose, Fenton & Beauchamp, SAE 2006-01-0908: three NHTSA car-to-SUV tests entered as
 # printed (examples/rose2006_nhtsa*_us.json). The 1 % relative tolerance is the one
 # issue 12 set before any computation ("within about 1 %"), the agreement
-# validation/README.md reports for a careful reproduction. How the energies are compared
+# impactsym/data/validation/README.md reports for a careful reproduction. How the energies are compared
 # was changed AFTER test 4364 had been run, and is stated here as such: its transcribed
 # inputs give an initial kinetic energy 0.54 % below the published one, and its raw TLt
 # missed by 1.27 %; the energy losses are therefore compared as fractions of the initial
 # kinetic energy (4364 TLt then -0.73 %), and the initial kinetic energy itself
 # separately, also within 1 %. Delta-V and |yaw rate| are compared directly.
-ROSE = ROOT / "validation" / "nhtsa_vehicle_to_vehicle_rose2006.csv"
+ROSE = ROOT / "impactsym" / "data" / "validation" / "nhtsa_vehicle_to_vehicle_rose2006.csv"
 TOLERANCE = 0.01
 
 

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from impactsym.cli import main
 from impactsym.codes import FLAG_MESSAGES
 from impactsym.scene import load_scene
+from tests.helpers import run_cli as run
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
@@ -25,13 +25,6 @@ EXAMPLE_FILES = [
 ENERGY_CREATED = 1
 
 CONVENTIONS_SCENE = json.loads((EXAMPLES / "two_car_us.json").read_text())
-
-
-def run(capsys, *argv):
-    """Run ``impactsym`` in-process; return (exit code, stdout, stderr)."""
-    code = main([str(arg) for arg in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def solve_json(capsys, path):

@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 import impactsym
+from impactsym._kernels import PRESETS
 from impactsym.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -48,8 +49,8 @@ def test_rows_equal_each_model_solved_alone(comparison):
     for model in ("brach", "limpert", "impac_sideswipe", "particle"):
         keep = {
             "normal_angle",
-            *impactsym.scene.PRESETS[model]["required"],
-            *impactsym.scene.PRESETS[model]["optional"],
+            *PRESETS[model]["required"],
+            *PRESETS[model]["optional"],
         }
         alone = impactsym.solve(
             {**DATA, "model": model, "impact": {k: v for k, v in DATA["impact"].items() if k in keep}}

@@ -3,7 +3,7 @@ EDCRASH cap, absorbed vs dissipated crush energy, the effective-mass delta-V,
 scenes without an impact block, crush-only compare, and one-line errors (API and CLI).
 
 Expected values come from outside the kernels: the published table (read here
-with the csv module from validation/, the repository's copy of the shared data),
+with the csv module from impactsym/data/, the one copy the runtime reads),
 trigonometry at known angles, and the 1-D impact algebra written out by hand.
 """
 
@@ -20,7 +20,7 @@ import pytest
 
 import impactsym
 from impactsym.cli import main
-from impactsym.crash3_tables import class_dimensions, stiffness
+from impactsym.crash3.tables import class_dimensions, stiffness
 from impactsym.scene import SceneError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -37,7 +37,7 @@ def barrier(pdof=0.0, **crush):
 
 
 def published_rows():
-    with open(ROOT / "validation" / "crash3_stiffness_categories.csv", newline="") as handle:
+    with open(ROOT / "impactsym" / "data" / "crash3_stiffness_categories.csv", newline="") as handle:
         return list(csv.DictReader(handle))
 
 

@@ -7,7 +7,6 @@ answer (exit 2, the field named) or the quiet behaviour the issue asks for.
 import dataclasses
 import json
 import math
-import os
 import re
 import signal
 import subprocess
@@ -20,30 +19,19 @@ import pandas as pd
 import pytest
 
 import impactsym
-from impactsym.cli import COMMANDS, main
+from impactsym.cli import COMMANDS
 from impactsym.codes import FLAG_E_OUT_OF_RANGE
 from impactsym.reconstruct import moment_warnings
 from impactsym.result import json_number, without_residue
 from impactsym.scene import load_scene
+from tests.helpers import cli_argv as _cli
+from tests.helpers import cli_env as _env
+from tests.helpers import one_line_error
+from tests.helpers import run_cli as run
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 SCENE = json.loads((EXAMPLES / "two_car_us.json").read_text())
-
-
-def run(capsys, *argv):
-    """Run ``impactsym`` in-process; return (exit code, stdout, stderr)."""
-    code = main([str(arg) for arg in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def one_line_error(capsys, *argv) -> str:
-    """The stderr line of a command that must fail with exit 2 and print nothing else."""
-    code, out, err = run(capsys, *argv)
-    assert code == 2, (code, out, err)
-    assert out == "" and err.count("\n") == 1 and err.startswith("impactsym: error: "), err
-    return err
 
 
 # --------------------------------------------------------------------------- 1. scene files
@@ -303,15 +291,6 @@ def test_residue_is_judged_against_the_scale_of_its_unit():
 # --------------------------------------------------------------------------- 5. the command line
 
 
-def _cli(*argv) -> list[str]:
-    """The command line of ``impactsym`` in a subprocess of this checkout."""
-    return [sys.executable, "-m", "impactsym", *map(str, argv)]
-
-
-def _env(**extra) -> dict:
-    return {**os.environ, "PYTHONPATH": str(ROOT), **extra}
-
-
 def test_a_plot_error_names_the_option_once(capsys):
     err = one_line_error(capsys, "solve", EXAMPLES / "two_car_us.json", "--plot", "out.txt")
     assert err.count("--plot") == 1 and "argument" not in err
@@ -520,7 +499,7 @@ def test_a_signal_inside_llvmlites_object_cache_hook_is_sent_again_not_lost():
     # handler's test runs inside it (from a profile hook).
     from llvmlite.binding import executionengine
 
-    from impactsym import cli
+    from impactsym.cli import signals
 
     class Engine:
         _object_cache_notify = None  # the hook returns at once
@@ -530,7 +509,7 @@ def test_a_signal_inside_llvmlites_object_cache_hook_is_sent_again_not_lost():
 
     def profiler(frame, event, arg):
         if event == "call" and frame.f_code is hook:
-            inside.append(cli._deferred(signal.SIGUSR1, frame))
+            inside.append(signals._deferred(signal.SIGUSR1, frame))
 
     received = []
     previous = signal.signal(signal.SIGUSR1, lambda signum, frame: received.append(signum))
@@ -553,7 +532,7 @@ def test_a_signal_inside_a_finaliser_is_sent_again_not_lost():
     # Python drops an exception raised in __del__ (numba and llvmlite free compiler
     # objects there), so a Ctrl-C landing there would be lost: the CLI's handler
     # leaves it and sends the signal again once the finaliser has returned.
-    from impactsym import cli
+    from impactsym.cli import signals
 
     received = []
     previous = signal.signal(signal.SIGUSR1, lambda signum, frame: received.append(signum))
@@ -561,11 +540,11 @@ def test_a_signal_inside_a_finaliser_is_sent_again_not_lost():
 
         class Finalised:
             def __del__(self):
-                received.append(cli._deferred(signal.SIGUSR1, sys._getframe()))
+                received.append(signals._deferred(signal.SIGUSR1, sys._getframe()))
 
         Finalised()  # finalised at once (no other reference)
         assert received == [True]
-        assert cli._deferred(signal.SIGUSR1, sys._getframe()) is False
+        assert signals._deferred(signal.SIGUSR1, sys._getframe()) is False
         deadline = time.monotonic() + 5
         while len(received) < 2 and time.monotonic() < deadline:
             time.sleep(0.01)

@@ -1,9 +1,13 @@
-"""Packaging and style: the wheel adds one import name, the sdist carries the
-tests' inputs, and the code passes the linter (ruff, configured in pyproject.toml)."""
+"""Packaging and style: the wheel adds one import name and is whole (installed
+in a fresh venv, every command runs outside the checkout and prints what the
+checkout prints), the sdist carries the tests' inputs, and the code passes the
+linter (ruff, configured in pyproject.toml)."""
 
 from __future__ import annotations
 
+import ast
 import os
+import shutil
 import subprocess
 import sys
 import tarfile
@@ -22,7 +26,6 @@ SDIST_DIRS = (
     "benchmarks",
     "examples",
     "notebooks",
-    "validation",
 )
 
 
@@ -76,12 +79,32 @@ def test_the_wheel_installs_only_the_impactsym_import_name(dists):
         sorted(top)
     )
     # generated/ is mapped into the package; derive/ (SymPy, build time only) is not shipped
-    assert {
-        "impactsym/_generated/__init__.py",
-        "impactsym/_generated/planar.py",
-        "impactsym/testing/reference.py",
-    } <= set(names)
+    assert {"impactsym/_generated/__init__.py", "impactsym/_generated/planar.py"} <= set(names)
     assert not any("derive/" in name for name in names)
+    # test support (mpmath, the test extra) stays in the checkout and the sdist
+    assert not any(name.startswith("impactsym/testing/") for name in names)
+
+
+@pytest.mark.slow
+def test_the_wheel_ships_the_validation_data_once_and_no_test_dependency(dists):
+    """What `validate` reads is in the wheel, each file once; no shipped module
+    imports a test-only package (mpmath, pytest, hypothesis)."""
+    _, wheel = dists
+    archive = zipfile.ZipFile(wheel)
+    names = archive.namelist()
+    shipped = {name.rpartition("/")[2] for name in names if name.endswith(".csv")}
+    data = ROOT / "impactsym" / "data"
+    assert {path.name for path in data.rglob("*.csv")} == shipped
+    assert len([n for n in names if n.endswith(".csv")]) == len(shipped)  # no table twice
+    for name in (n for n in names if n.endswith(".py")):
+        tree = ast.parse(archive.read(name), name)
+        imported = {
+            alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names
+        }
+        imported |= {
+            node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom) and node.module
+        }
+        assert not {m.split(".")[0] for m in imported} & {"mpmath", "pytest", "hypothesis"}, name
 
 
 @pytest.mark.slow
@@ -140,3 +163,93 @@ def test_the_installed_wheel_solves_with_its_own_generated_code(dists, tmp_path)
     )
     assert proc.returncode == 0, proc.stderr[-3000:]
     assert float(proc.stdout.strip().splitlines()[-1]) > 0.0
+
+
+#: Every command, as a user runs it on their own files (copied from examples/ into a
+#: folder outside the checkout). Each prints the same as from the checkout.
+WHOLE_PACKAGE_RUNS = [
+    ["--version"],
+    ["solve", "two_car_us.json", "--json"],
+    ["solve", "intersection_si.toml", "--plot", "scene.png"],
+    ["invert", "invert_two_car_si.json"],
+    ["reconstruct", "reconstruct_intersection_us_casefile.json"],
+    [
+        "reconstruct",
+        "reconstruct_intersection_uncertain.json",
+        "--uncertainty",
+        "--draws",
+        "2000",
+        "--seed",
+        "1",
+    ],
+    ["crash3", "crash3_two_car_us.json", "--json"],
+    ["compare", "models_two_car_us.json"],
+    ["sweep", "two_car_us.json", "--vary", "e=0:0.3:4", "--vary", "mu=0:0.5:3", "--no-progress"],
+    ["sample", "two_car_us.json", "--dist", "e=uniform:0:0.3", "-n", "2000", "--seed", "12", "--no-progress"],
+    ["validate"],
+    ["validate", "--markdown", "--plots", "figures"],
+    # compiling every driver takes minutes: the installed command is checked to parse and start
+    ["compile", "--help"],
+]
+
+
+@pytest.fixture(scope="module")
+def installed(dists, tmp_path_factory):
+    """A fresh venv with the wheel installed (pip, no index), seeing the already
+    installed run-time dependencies (numpy, numba, the extras) through a .pth
+    file instead of downloading them; and a work folder outside the checkout."""
+    import numpy
+
+    _, wheel = dists
+    venv = tmp_path_factory.mktemp("venv")
+    subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True, timeout=300)
+    python = venv / "bin" / "python"
+    site = subprocess.run(
+        [str(python), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.strip()
+    Path(site, "installed_dependencies.pth").write_text(str(Path(numpy.__file__).parents[1]) + "\n")
+    subprocess.run(
+        [str(python), "-m", "pip", "install", "--no-deps", "--no-index", "--quiet", str(wheel)],
+        check=True,
+        timeout=300,
+    )
+    work = tmp_path_factory.mktemp("outside")
+    for argv in WHOLE_PACKAGE_RUNS:
+        for arg in argv:
+            if (ROOT / "examples" / arg).is_file():
+                shutil.copy(ROOT / "examples" / arg, work / arg)
+    return venv / "bin" / "impactsym", work
+
+
+def _run(command: list[str], cwd: Path) -> subprocess.CompletedProcess:
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+    return subprocess.run(command, cwd=cwd, capture_output=True, text=True, timeout=900, env=env)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("argv", WHOLE_PACKAGE_RUNS, ids=" ".join)
+def test_every_command_runs_from_the_installed_wheel_outside_the_checkout(installed, argv, tmp_path):
+    script, work = installed
+    done = _run([str(script), *argv], work)
+    assert done.returncode == 0, done.stderr[-3000:]
+    where = _run([str(script.parent / "python"), "-c", "import impactsym; print(impactsym.__file__)"], work)
+    assert not where.stdout.startswith(str(ROOT)), where.stdout  # the installed copy, not the checkout
+    # The checkout prints the same (figures go to a folder of their own).
+    mine = tmp_path / "checkout"
+    shutil.copytree(work, mine, ignore=shutil.ignore_patterns("figures", "*.png"))
+    here = subprocess.run(
+        [sys.executable, "-m", "impactsym", *argv],
+        cwd=mine,
+        capture_output=True,
+        text=True,
+        timeout=900,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
+    assert here.returncode == 0, here.stderr[-3000:]
+    assert done.stdout == here.stdout
+    if "--plot" in argv or "--plots" in argv:
+        made = work / argv[argv.index("--plot") + 1] if "--plot" in argv else work / "figures"
+        assert made.exists() and (made.is_file() or len(list(made.glob("*.png"))) == 4)

@@ -10,6 +10,7 @@ import pytest
 import impactsym
 from impactsym import plot
 from impactsym.cli import main
+from tests.helpers import new_axes
 
 matplotlib.use("Agg")
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -65,15 +66,6 @@ def test_cli_plot_rejects_an_unknown_image_type(tmp_path, capsys):
 # --------------------------------------------------------------------------- geometry and API
 
 
-def _axes():
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure()
-    FigureCanvasAgg(fig)
-    return fig.add_subplot()
-
-
 def _markers(ax, marker):
     return [tuple(line.get_xydata()[0]) for line in ax.lines if line.get_marker() == marker]
 
@@ -91,7 +83,7 @@ def test_import_impactsym_loads_neither_matplotlib_nor_ipywidgets():
 
 def test_centres_of_gravity_sit_at_minus_r_from_the_impact_centre():
     ax = plot.scene(
-        impactsym.solve(EXAMPLES / "two_car_us.json"), _axes(), scene=EXAMPLES / "two_car_us.json"
+        impactsym.solve(EXAMPLES / "two_car_us.json"), new_axes(), scene=EXAMPLES / "two_car_us.json"
     )
     assert _markers(ax, "X") == [(0.0, 0.0)]  # the impact centre at the origin
     cgs = _markers(ax, "+")
@@ -103,7 +95,7 @@ def test_impact_position_moves_the_whole_scene():
 
     data = json.loads((EXAMPLES / "two_car_us.json").read_text())
     data["impact"]["position"] = [10.0, -2.0]
-    ax = plot.scene(data, _axes())
+    ax = plot.scene(data, new_axes())
     assert _markers(ax, "X") == [pytest.approx((10.0, -2.0))]
     assert _markers(ax, "+") == [pytest.approx((4.0, -3.0)), pytest.approx((11.5, 2.0))]
 
@@ -120,7 +112,7 @@ def test_particles_are_placed_either_side_of_the_impact_centre_along_n():
             {"name": "b", "mass": 2.0, "velocity": [-1.0, 0.0]},
         ],
     }
-    ax = plot.scene(impactsym.solve(data), _axes(), scene=data)
+    ax = plot.scene(impactsym.solve(data), new_axes(), scene=data)
     (x1, y1), (x2, y2) = _markers(ax, "+")
     n = (math.cos(math.radians(30.0)), math.sin(math.radians(30.0)))
     assert (x1, y1) == pytest.approx((-x2, -y2))  # symmetric about the impact centre
@@ -131,7 +123,9 @@ def test_outlines_barrier_and_legend_with_units():
     from matplotlib.patches import Polygon
 
     ax = plot.scene(
-        impactsym.solve(EXAMPLES / "intersection_si.toml"), _axes(), scene=EXAMPLES / "intersection_si.toml"
+        impactsym.solve(EXAMPLES / "intersection_si.toml"),
+        new_axes(),
+        scene=EXAMPLES / "intersection_si.toml",
     )
     outlines = [p for p in ax.patches if isinstance(p, Polygon) and len(p.get_xy()) == 5]
     assert len(outlines) == 2  # two rectangles (closed: 5 vertices)
@@ -141,7 +135,7 @@ def test_outlines_barrier_and_legend_with_units():
     assert any(label.startswith("PDOF") for label in labels)
     assert ax.get_legend().get_title().get_text().startswith("arrows: 1 m = ")
     barrier = plot.scene(
-        impactsym.solve(EXAMPLES / "barrier_si.json"), _axes(), scene=EXAMPLES / "barrier_si.json"
+        impactsym.solve(EXAMPLES / "barrier_si.json"), new_axes(), scene=EXAMPLES / "barrier_si.json"
     )
     assert any(p.get_hatch() for p in barrier.patches)
     assert "fixed barrier" in [text.get_text() for text in barrier.get_legend().get_texts()]
@@ -150,7 +144,7 @@ def test_outlines_barrier_and_legend_with_units():
 def test_pdof_is_the_direction_of_the_impulse_and_matches_reconstruction():
     path = EXAMPLES / "reconstruct_two_car_si.json"
     result = impactsym.reconstruct(path)
-    ax = plot.scene(result, _axes(), scene=path)
+    ax = plot.scene(result, new_axes(), scene=path)
     texts = [text.get_text().replace(":\n", ": ") for text in ax.texts]  # a crowded label is on two lines
     for vehicle in result.vehicles:
         assert f"{vehicle.name}: PDOF {vehicle.pdof_deg:.0f}° ({vehicle.pdof_clock} o'clock)" in texts
@@ -168,13 +162,13 @@ def test_a_duck_typed_result_is_drawn_with_its_scene():
         ],
         units="US",
     )
-    ax = plot.scene(fake, _axes(), scene=path)  # no Pn/Pt: PDOF from the delta-V direction
+    ax = plot.scene(fake, new_axes(), scene=path)  # no Pn/Pt: PDOF from the delta-V direction
     assert "velocity after [ft/s]" in [text.get_text() for text in ax.get_legend().get_texts()]
     with pytest.raises(TypeError, match="scene="):
-        plot.scene(fake, _axes())
+        plot.scene(fake, new_axes())
 
 
-def test_scene_without_result_and_pyplot_default_axes():
+def test_scene_without_result_and_pyplot_defaultnew_axes():
     import matplotlib.pyplot as plt
 
     ax = plot.scene(EXAMPLES / "two_car_us.json")
@@ -188,5 +182,5 @@ def test_default_velocity_scale_is_what_scene_uses():
     path = EXAMPLES / "intersection_si.toml"
     result = impactsym.solve(path)
     k = plot.default_velocity_scale(result, scene=path)
-    ax = plot.scene(result, _axes(), scene=path)
+    ax = plot.scene(result, new_axes(), scene=path)
     assert ax.get_legend().get_title().get_text() == f"arrows: 1 m = {1.0 / k:.3g} m/s"

@@ -15,7 +15,7 @@ import pytest
 import impactsym
 from impactsym import plot
 from impactsym.cli import main
-from impactsym.plot_crash3 import crash3_figure
+from impactsym.plot import crash3_figure
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 CRASH3 = sorted(EXAMPLES.glob("crash3_*.json"))

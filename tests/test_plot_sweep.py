@@ -15,7 +15,9 @@ import pandas as pd
 import pytest
 
 import impactsym
-from impactsym import plot, plot_sweep
+from impactsym import plot
+from impactsym.pictures import sweep as plot_sweep
+from tests.helpers import new_axes
 
 matplotlib.use("Agg")
 SCENE = Path(__file__).resolve().parent.parent / "examples" / "intersection_si.toml"
@@ -41,15 +43,6 @@ def _frame(**axes) -> pd.DataFrame:
 @pytest.fixture(scope="module")
 def e_mu():
     return _frame(e=E, mu=MU)
-
-
-def _axes():
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig.add_subplot()
 
 
 def _by_gid(ax, gid):
@@ -83,7 +76,7 @@ def test_impossible_mask_covers_exactly_the_flagged_cells(e_mu):
     assert flagged.any() and not flagged.all()
     assert (_grid_of(e_mu, "mu", "e", "mu") < _grid_of(e_mu, "mu_c", "e", "mu"))[flagged].any()  # beyond μ_c
     shuffled = e_mu.sample(frac=1.0, random_state=1)  # row order does not matter
-    ax = plot_sweep.sweep(shuffled, "e", "mu", ax=_axes(), units="SI")
+    ax = plot_sweep.sweep(shuffled, "e", "mu", ax=new_axes(layout="constrained"), units="SI")
     (mask,) = _by_gid(ax, "impossible")
     np.testing.assert_array_equal(_covered(mask, E, MU), flagged)
     assert not _by_gid(ax, "not_solved")  # every row solved
@@ -92,7 +85,9 @@ def test_impossible_mask_covers_exactly_the_flagged_cells(e_mu):
     assert not np.ma.getmaskarray(values).any()
     np.testing.assert_allclose(values.compressed(), _grid_of(e_mu, "TL", "e", "mu").ravel())
     assert plot_sweep.IMPOSSIBLE_LABEL in _legend_texts(ax)
-    transposed = plot_sweep.sweep(shuffled, "mu", "e", ax=_axes())  # two flagged runs along each row
+    transposed = plot_sweep.sweep(
+        shuffled, "mu", "e", ax=new_axes(layout="constrained")
+    )  # two flagged runs along each row
     (mask,) = _by_gid(transposed, "impossible")
     np.testing.assert_array_equal(_covered(mask, MU, E), flagged.T)
 
@@ -101,7 +96,7 @@ def test_not_solved_cells_have_their_own_mask():
     df = _frame(normal_angle=np.linspace(-30.0, 80.0, 12), mu=np.linspace(-0.8, 0.6, 8))
     unsolved = _grid_of(df, "status", "normal_angle", "mu") != 0
     assert unsolved.any() and not unsolved.all()  # a steep normal: not approaching
-    ax = plot_sweep.sweep(df, "normal_angle", "mu", ax=_axes())
+    ax = plot_sweep.sweep(df, "normal_angle", "mu", ax=new_axes(layout="constrained"))
     xs, ys = np.unique(df["normal_angle"]), np.unique(df["mu"])
     (mask,) = _by_gid(ax, "not_solved")
     np.testing.assert_array_equal(_covered(mask, xs, ys), unsolved)
@@ -112,7 +107,7 @@ def test_not_solved_cells_have_their_own_mask():
 
 
 def test_cell_edges_are_halfway_between_non_uniform_values(e_mu):
-    ax = plot_sweep.sweep(e_mu, "e", "mu", ax=_axes())
+    ax = plot_sweep.sweep(e_mu, "e", "mu", ax=new_axes(layout="constrained"))
     (mesh,) = _by_gid(ax, "values")
     xedges = mesh.get_coordinates()[0, :, 0]
     np.testing.assert_allclose(xedges, [-0.025, 0.025, 0.075, 0.15, 0.3, 0.55, 0.85, 1.15])
@@ -120,7 +115,7 @@ def test_cell_edges_are_halfway_between_non_uniform_values(e_mu):
 
 
 def test_a_single_value_along_an_axis_gets_a_cell(e_mu):
-    ax = plot_sweep.sweep(e_mu[e_mu.e == 0.4], "e", "mu", color="dV1", ax=_axes())
+    ax = plot_sweep.sweep(e_mu[e_mu.e == 0.4], "e", "mu", color="dV1", ax=new_axes(layout="constrained"))
     (mesh,) = _by_gid(ax, "values")
     np.testing.assert_allclose(mesh.get_coordinates()[0, :, 0], [0.36, 0.44])
     (line,) = _by_gid(ax, "mu_c")  # spans the single cell
@@ -130,12 +125,12 @@ def test_a_single_value_along_an_axis_gets_a_cell(e_mu):
 def test_mu_c_line_follows_mu_c_against_the_other_axis(e_mu):
     mu_c = e_mu.groupby("e")["mu_c"].first().to_numpy()
     assert np.ptp(mu_c) > 0.05  # μ_c varies with e
-    ax = plot_sweep.sweep(e_mu, "e", "mu", ax=_axes())
+    ax = plot_sweep.sweep(e_mu, "e", "mu", ax=new_axes(layout="constrained"))
     (line,) = _by_gid(ax, "mu_c")
     np.testing.assert_allclose(line.get_xdata(), E)
     np.testing.assert_allclose(line.get_ydata(), mu_c)
     assert "μ = μ_c" in _legend_texts(ax)
-    transposed = plot_sweep.sweep(e_mu, "mu", "e", ax=_axes())
+    transposed = plot_sweep.sweep(e_mu, "mu", "e", ax=new_axes(layout="constrained"))
     (line,) = _by_gid(transposed, "mu_c")
     np.testing.assert_allclose(line.get_xdata(), mu_c)
     np.testing.assert_allclose(line.get_ydata(), E)
@@ -143,7 +138,7 @@ def test_mu_c_line_follows_mu_c_against_the_other_axis(e_mu):
 
 def test_no_mu_c_line_without_mu_on_an_axis():
     df = _frame(e=E, normal_angle=np.array([0.0, 10.0, 20.0]))
-    ax = plot_sweep.sweep(df, "e", "normal_angle", ax=_axes())
+    ax = plot_sweep.sweep(df, "e", "normal_angle", ax=new_axes(layout="constrained"))
     assert not _by_gid(ax, "mu_c")
     assert "mu" in df and plot_sweep.MU_C_LABEL not in [line.get_label() for line in ax.lines]
 
@@ -151,10 +146,10 @@ def test_no_mu_c_line_without_mu_on_an_axis():
 def test_colourbar_label_carries_the_quantity_and_units(e_mu):
     labels = {}
     for units in ("SI", "US", None):
-        ax = plot_sweep.sweep(e_mu, "e", "mu", color="dV1", ax=_axes(), units=units)
+        ax = plot_sweep.sweep(e_mu, "e", "mu", color="dV1", ax=new_axes(layout="constrained"), units=units)
         labels[units] = [other.get_ylabel() for other in ax.figure.axes if other is not ax][0]
     assert labels == {"SI": "delta-V dV1 [m/s]", "US": "delta-V dV1 [ft/s]", None: "delta-V dV1"}
-    ax = plot_sweep.sweep(e_mu, "e", "mu", ax=_axes(), units="US")
+    ax = plot_sweep.sweep(e_mu, "e", "mu", ax=new_axes(layout="constrained"), units="US")
     assert [other.get_ylabel() for other in ax.figure.axes if other is not ax] == ["energy loss TL [ft·lb]"]
 
 
@@ -165,7 +160,7 @@ def test_colour_range_spans_every_solved_cell():
     solved = df["status"].to_numpy() == 0
     impossible = solved & (df["flags"].to_numpy() & IMPOSSIBLE != 0)
     assert impossible.any() and (~solved).any()
-    ax = plot_sweep.sweep(df, "normal_angle", "mu", ax=_axes())
+    ax = plot_sweep.sweep(df, "normal_angle", "mu", ax=new_axes(layout="constrained"))
     (mesh,) = _by_gid(ax, "values")
     tl = df["TL"].to_numpy()[solved]
     assert mesh.get_clim() == (pytest.approx(tl.min()), pytest.approx(tl.max()))
@@ -196,7 +191,7 @@ def test_the_legend_is_off_the_data(e_mu, y):
 
 def test_line_plot_marks_the_impossible_points(e_mu):
     one = e_mu[e_mu.e == 0.2].sample(frac=1.0, random_state=2)
-    ax = plot_sweep.sweep(one, "mu", ax=_axes(), units="SI")
+    ax = plot_sweep.sweep(one, "mu", ax=new_axes(layout="constrained"), units="SI")
     (line,) = _by_gid(ax, "values")
     ordered = one.sort_values("mu")
     np.testing.assert_allclose(line.get_xdata(), ordered["mu"])
@@ -212,7 +207,7 @@ def test_line_plot_marks_the_impossible_points(e_mu):
 
 def test_line_plot_of_several_columns(e_mu):
     one = e_mu[e_mu.mu == MU[5]]
-    ax = plot_sweep.sweep(one, "e", color=["dV1", "dV2"], ax=_axes(), units="SI")
+    ax = plot_sweep.sweep(one, "e", color=["dV1", "dV2"], ax=new_axes(layout="constrained"), units="SI")
     lines = _by_gid(ax, "values")
     assert [line.get_label() for line in lines] == ["delta-V dV1 [m/s]", "delta-V dV2 [m/s]"]
     np.testing.assert_allclose(lines[1].get_ydata(), one.sort_values("e")["dV2"])
@@ -228,29 +223,31 @@ def test_line_plot_of_several_columns(e_mu):
 )
 def test_unknown_column_is_named(e_mu, args, name):
     with pytest.raises(ValueError, match=f"^{name}: no such column"):
-        plot_sweep.sweep(e_mu, *args, ax=_axes())
+        plot_sweep.sweep(e_mu, *args, ax=new_axes(layout="constrained"))
 
 
 def test_a_varied_column_the_axes_do_not_use_asks_to_filter(e_mu):
     with pytest.raises(ValueError, match="varies mu.*filter") as error:
-        plot_sweep.sweep(e_mu, "e", ax=_axes())
+        plot_sweep.sweep(e_mu, "e", ax=new_axes(layout="constrained"))
     assert "\n" not in str(error.value)
     three = _frame(e=E[:3], mu=MU[:3], m1=np.array([1200.0, 1500.0]))
     with pytest.raises(ValueError, match="varies m1"):
-        plot_sweep.sweep(three, "e", "mu", ax=_axes())
-    plot_sweep.sweep(three[three.m1 == 1500.0], "e", "mu", ax=_axes())  # filtered: fine
+        plot_sweep.sweep(three, "e", "mu", ax=new_axes(layout="constrained"))
+    plot_sweep.sweep(
+        three[three.m1 == 1500.0], "e", "mu", ax=new_axes(layout="constrained")
+    )  # filtered: fine
 
 
 def test_rows_that_do_not_form_a_full_grid(e_mu):
     with pytest.raises(ValueError, match="not a full grid"):
-        plot_sweep.sweep(e_mu.iloc[1:], "e", "mu", ax=_axes())
+        plot_sweep.sweep(e_mu.iloc[1:], "e", "mu", ax=new_axes(layout="constrained"))
 
 
 def test_bad_units_and_a_list_colour_on_a_heatmap(e_mu):
     with pytest.raises(ValueError, match="units"):
-        plot_sweep.sweep(e_mu, "e", "mu", ax=_axes(), units="metric")
+        plot_sweep.sweep(e_mu, "e", "mu", ax=new_axes(layout="constrained"), units="metric")
     with pytest.raises(ValueError, match="heatmap shows one column"):
-        plot_sweep.sweep(e_mu, "e", "mu", color=["dV1", "dV2"], ax=_axes())
+        plot_sweep.sweep(e_mu, "e", "mu", color=["dV1", "dV2"], ax=new_axes(layout="constrained"))
 
 
 # --------------------------------------------------------------------------- file

@@ -17,7 +17,7 @@ import pytest
 
 import impactsym
 from impactsym import _kernels
-from impactsym.cli import main
+from tests.helpers import run_cli as run
 
 sweeps = importlib.import_module("impactsym.batch.sweeps")
 quantiles = importlib.import_module("impactsym.batch.quantiles")
@@ -490,12 +490,6 @@ def test_progress_by_default_only_on_a_terminal_for_large_work(monkeypatch, caps
 
 
 # --------------------------------------------------------------------------- command line
-
-
-def run(capsys, *argv):
-    code = main([str(arg) for arg in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def test_cli_sweep_prints_a_summary(capsys):

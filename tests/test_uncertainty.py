@@ -19,8 +19,9 @@ import pytest
 from mpmath import mp
 
 from impactsym import _kernels, solve_batch
-from impactsym import propagation as U
 from impactsym.testing import reference
+from impactsym.uncertainty import propagation as U
+from tests.helpers import assert_gradient_close, mp_gradient
 
 SCENE = {
     "m1": 1500.0,
@@ -44,29 +45,6 @@ SCENE = {
 }
 
 
-def _close(got, want, names, outputs):
-    for o in outputs:
-        row = [float(want[o][x]) for x in names]
-        scale = max(abs(v) for v in row)
-        for x, w in zip(names, row):
-            g = got.get(f"d_{o}__d_{x}", 0.0)
-            assert abs(g - w) <= 1e-8 * scale, (o, x, g, w)
-
-
-def _mp_gradient(func, point: dict, names, outputs):
-    """{output: {input: d output/d input}} by mpmath.diff at 50 digits (one
-    reference solve per step and input: all outputs from the same solves)."""
-    grads = {o: {} for o in outputs}
-    with mp.workdps(50):
-        for x in names:
-            for o in outputs:
-                # The reference rounds to 50 digits inside: a central step
-                # of 1e-15 relative (error ~1e-30) instead of mpmath's default.
-                step = mp.mpf("1e-15") * max(1, abs(point[x]))
-                grads[o][x] = mp.diff(lambda t, x=x, o=o: func({**point, x: t})[o], mp.mpf(point[x]), h=step)
-    return grads
-
-
 @pytest.mark.parametrize(
     "model,critical", [("rigid", False), ("rigid", True), ("particle", False), ("particle", True)]
 )
@@ -81,8 +59,8 @@ def test_forward_jacobian_matches_reference(model, critical):
     ks = _kernels.JACOBIAN[model + ("_critical" if critical else "")]
     got = _kernels.run_one(ks, point, ks.outputs)
     assert got["status"] == 0
-    want = _mp_gradient(lambda p: reference.solve_reference(p, model, critical), point, names, outputs)
-    _close(got, want, names, outputs)
+    want = mp_gradient(lambda p: reference.solve_reference(p, model, critical), point, names, outputs)
+    assert_gradient_close(got, want, names, outputs)
 
 
 def _mp_reconstruct(p: dict) -> dict:
@@ -133,7 +111,7 @@ def test_reconstruct_jacobian_matches_reference():
     assert got["status"] == 0
     names = list(ks.inputs)
     outputs = ["s1", "s2", "v1x", "v2y", "e", "Pn", "Pt"]
-    _close(got, _mp_gradient(_mp_reconstruct, point, names, outputs), names, outputs)
+    assert_gradient_close(got, mp_gradient(_mp_reconstruct, point, names, outputs), names, outputs)
 
 
 # --------------------------------------------------------------------------- the method

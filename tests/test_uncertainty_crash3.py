@@ -20,9 +20,6 @@ Tolerances, fixed before looking at results:
 import copy
 import json
 import math
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -30,7 +27,7 @@ from mpmath import mp
 
 import impactsym
 from impactsym import _kernels
-from tests.test_uncertainty import _close  # each derivative within 1e-8 of its row's largest
+from tests.helpers import assert_gradient_close, mp_gradient, run_cli_subprocess
 
 ROOT = Path(__file__).resolve().parents[1]
 TWO_CAR = json.loads((ROOT / "examples" / "crash3_two_car_us.json").read_text())
@@ -83,26 +80,6 @@ def _mp_delta_v(p: dict, energy: str) -> dict:
     }
 
 
-def _mp_gradient(func, point: dict, names, outputs, direction: int = 0):
-    """50-digit finite-difference derivatives of func's outputs; each evaluation
-    of func (a quadrature for the energies) is made once and shared by the
-    outputs, which mp.diff evaluates at the same points."""
-    grads = {o: {} for o in outputs}
-    with mp.workdps(50):
-        for x in names:
-            step = mp.mpf("1e-15") * max(1, abs(point[x]))
-            values = {}
-
-            def at(t, x=x, values=values):
-                if t not in values:
-                    values[t] = func({**point, x: t})
-                return values[t]
-
-            for o in outputs:
-                grads[o][x] = mp.diff(lambda t, o=o: at(t)[o], mp.mpf(point[x]), h=step, direction=direction)
-    return grads
-
-
 ENERGY_POINT = {"A": 300.0, "B": 60.0, "width": 60.0, "C1": 9.0, "C2": 11.0, "C3": 12.0}
 ENERGY_POINT.update(C4=12.5, C5=11.0, C6=8.0)
 
@@ -116,7 +93,7 @@ def test_energy_jacobian_matches_reference_with_both_corrections(n, alpha_deg):
     got = _kernels.run_one(ks, point, ks.outputs)
     assert got["status"] == 0
     names, outputs = list(ks.inputs), ["E_crush", "E", "E_woolley"]
-    _close(got, _mp_gradient(lambda p: _mp_energy(p, n), point, names, outputs), names, outputs)
+    assert_gradient_close(got, mp_gradient(lambda p: _mp_energy(p, n), point, names, outputs), names, outputs)
     if abs(alpha_deg) > 45:  # beyond the cap: exactly no dependence on the PDOF
         assert got["d_E__d_alpha"] == 0.0 and got["d_E_woolley__d_alpha"] == 0.0
 
@@ -135,7 +112,7 @@ def test_energy_derivative_at_the_cap_is_the_mean_of_the_one_sided_ones(sign):
             at = {k: mp.mpf(v) for k, v in point.items()}
             at["alpha"] = sign * CAP
             sides = [
-                _mp_gradient(lambda p: _mp_energy(p, 6), at, ["alpha"], [out], direction=d)[out]["alpha"]
+                mp_gradient(lambda p: _mp_energy(p, 6), at, ["alpha"], [out], direction=d)[out]["alpha"]
                 for d in (-1, 1)
             ]
         assert (float(sides[0]) == 0.0) != (float(sides[1]) == 0.0)  # one side flat, one not
@@ -165,8 +142,8 @@ def test_delta_v_jacobian_matches_reference(energy):
     got = _kernels.run_one(ks, DV_POINT, ks.outputs)
     assert got["status"] == 0
     names, outputs = list(ks.inputs), ["P", "dV1", "dV2", "dV1x", "dV2y", "dV1_eff"]
-    want = _mp_gradient(lambda p: _mp_delta_v(p, energy), DV_POINT, names, outputs)
-    _close(got, want, names, outputs)
+    want = mp_gradient(lambda p: _mp_delta_v(p, energy), DV_POINT, names, outputs)
+    assert_gradient_close(got, want, names, outputs)
 
 
 # --------------------------------------------------------------------------- the method
@@ -254,24 +231,15 @@ def test_beyond_the_cap_the_pdof_does_not_move_the_energy(correction):
     assert u.outputs["vehicles[0].delta_v_magnitude"]["sd_linear"] > 0
 
 
-def _cli(*args, path: Path):
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    return subprocess.run(
-        [sys.executable, "-m", "impactsym", "crash3", str(path), *args],
-        env=env,
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-    )
-
-
 def test_cli_uncertainty_with_both_options(tmp_path):
     data = _near_linear_scene("dissipated", "crash3")
     del data["crash3"]
     scene = tmp_path / "scene.json"
     scene.write_text(json.dumps(data))
     flags = ("--energy", "absorbed", "--correction", "woolley", "--restitution", "0.4")
-    run = _cli("--uncertainty", "--draws", "2000", "--seed", "3", "--json", *flags, path=scene)
+    run = run_cli_subprocess(
+        "crash3", scene, "--uncertainty", "--draws", "2000", "--seed", "3", "--json", *flags
+    )
     assert run.returncode == 0, run.stderr
     obj = json.loads(run.stdout)
     assert obj["options"] == {"restitution": 0.4, "energy": "absorbed", "correction": "woolley"}
@@ -284,7 +252,7 @@ def test_cli_uncertainty_with_both_options(tmp_path):
         scene, command="crash3", draws=2000, seed=3, restitution=0.4, energy="absorbed", correction="woolley"
     )
     assert api.to_json_dict()["outputs"] == u["outputs"]
-    table = _cli("--uncertainty", "--draws", "500", "--seed", "3", *flags, path=scene)
+    table = run_cli_subprocess("crash3", scene, "--uncertainty", "--draws", "500", "--seed", "3", *flags)
     assert table.returncode == 0, table.stderr
     assert "absorbed" in table.stdout and "woolley" in table.stdout
 
@@ -292,7 +260,7 @@ def test_cli_uncertainty_with_both_options(tmp_path):
 def test_a_bad_option_is_a_one_line_error(tmp_path):
     scene = tmp_path / "scene.json"
     scene.write_text(json.dumps(_near_linear_scene("dissipated", "crash3")))
-    run = _cli("--uncertainty", "--draws", "100", "--correction", "wooley", path=scene)
+    run = run_cli_subprocess("crash3", scene, "--uncertainty", "--draws", "100", "--correction", "wooley")
     assert run.returncode == 2
     assert run.stderr.count("\n") == 1 and "correction" in run.stderr
     with pytest.raises(ValueError, match="crash3.energy"):

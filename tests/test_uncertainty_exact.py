@@ -17,7 +17,7 @@ import pytest
 from impactsym.batch import selection as _selection
 from impactsym.batch.plans import BLOCK, SamplePlan
 from impactsym.batch.quantiles import percentiles
-from impactsym.uncertainty_inputs import Input
+from impactsym.uncertainty.inputs import Input
 
 Q = (5.0, 50.0, 95.0)
 
@@ -75,7 +75,7 @@ def test_normal_transform_in_place_gives_the_same_numbers():
 def test_streamed_stats_give_numpy_percentiles(name, parts):
     """`Stats` fed chunk by chunk (its running extremes passed to the
     selection) gives numpy.percentile of all the values."""
-    from impactsym.uncertainty_result import Stats
+    from impactsym.uncertainty.result import Stats
 
     stats = Stats(0.0)
     with np.errstate(over="ignore", invalid="ignore"):  # the sums of 1e300s and infinities

@@ -1,6 +1,6 @@
 """CRASH3 uncertainty for RICSAC test 8 against Neades (PhD thesis, 2011).
 
-Inputs: validation/ricsac8_crash3.csv (Neades' App. D data). His tolerances:
+Inputs: impactsym/data/validation/ricsac8_crash3.csv (Neades' App. D data). His tolerances:
 crush ±7.62 cm, damage width ±15.24 cm, A and B ±10 %, PDOF ±20°, impact-centre
 distance (moment arm) ±7.62 cm, radius of gyration ±0.1 m, mass ±50 kg. His
 results: crush energy ±23.5 % (vehicle 1) and ±22.8 % (vehicle 2), delta-V
@@ -35,9 +35,9 @@ from pathlib import Path
 
 import numpy as np
 
-from impactsym import propagation as U
+from impactsym.uncertainty import propagation as U
 
-DATA = Path(__file__).resolve().parents[1] / "validation" / "ricsac8_crash3.csv"
+DATA = Path(__file__).resolve().parents[1] / "impactsym" / "data" / "validation" / "ricsac8_crash3.csv"
 PDOF_DEG = -20.5
 NEADES = {"energy": (0.235, 0.228), "delta_v": 0.18}
 

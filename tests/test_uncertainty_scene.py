@@ -1,14 +1,12 @@
 """Uncertainty through scene files: the API and ``--uncertainty`` on the four commands."""
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
 import impactsym
+from tests.helpers import run_cli_subprocess
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
@@ -32,17 +30,6 @@ def _uncertain(name: str, edit) -> dict:
     data = json.loads((EXAMPLES / name).read_text())
     edit(data)
     return data
-
-
-def _cli(*args, path: Path):
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    return subprocess.run(
-        [sys.executable, "-m", "impactsym", *args, str(path)],
-        env=env,
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-    )
 
 
 def _forward(d):
@@ -83,7 +70,7 @@ CASES = [
 def test_every_numeric_output_has_an_entry(tmp_path, command, name, edit):
     scene = tmp_path / "scene.json"
     scene.write_text(json.dumps(_uncertain(name, edit)))
-    run = _cli(command, "--uncertainty", "--draws", "3000", "--seed", "5", "--json", path=scene)
+    run = run_cli_subprocess(command, "--uncertainty", "--draws", "3000", "--seed", "5", "--json", scene)
     assert run.returncode == 0, run.stderr
     obj = json.loads(run.stdout)
     u = obj.pop("uncertainty")
@@ -96,7 +83,7 @@ def test_every_numeric_output_has_an_entry(tmp_path, command, name, edit):
 
 
 def test_api_reconstruction_speeds_and_plot(tmp_path):
-    from impactsym.uncertainty_plot import save_uncertainty_plot
+    from impactsym.uncertainty.plot import save_uncertainty_plot
 
     u = impactsym.uncertainty(
         EXAMPLES / "reconstruct_intersection_uncertain.json", command="reconstruct", draws=20_000, seed=3
@@ -112,12 +99,12 @@ def test_api_reconstruction_speeds_and_plot(tmp_path):
 
 def test_bad_draws_is_a_one_line_error(tmp_path):
     scene = EXAMPLES / "reconstruct_intersection_uncertain.json"
-    run = _cli("reconstruct", "--uncertainty", "--draws", "1", path=scene)
+    run = run_cli_subprocess("reconstruct", "--uncertainty", "--draws", "1", scene)
     assert run.returncode == 2
     assert run.stderr.count("\n") == 1 and "draws" in run.stderr
 
 
 def test_a_scene_without_distributions_is_refused(tmp_path):
-    run = _cli("solve", "--uncertainty", path=EXAMPLES / "two_car_us.json")
+    run = run_cli_subprocess("solve", "--uncertainty", EXAMPLES / "two_car_us.json")
     assert run.returncode == 2
     assert "no uncertain inputs" in run.stderr

@@ -1,6 +1,6 @@
 """notebooks/06_models.ipynb against the measured small-overlap barrier crashes.
 
-The notebook runs the Ford Fusion rows of validation/small_overlap_barrier_tests.csv
+The notebook runs the Ford Fusion rows of impactsym/data/validation/small_overlap_barrier_tests.csv
 through the general model (barrier fixed, μ = percent-of-critical × μ_c) and asserts
 its own tolerance. This test executes it, reads its prediction table back, and checks
 the tolerance stated here (chosen after seeing the data, README "Models"): for every
@@ -64,7 +64,7 @@ def test_errors_are_against_the_measured_file(fusion_table):
     """The table's measured columns are the file's (magnitudes, signed as predicted)."""
     import csv
 
-    with open(REPO_ROOT / "validation" / "small_overlap_barrier_tests.csv") as handle:
+    with open(REPO_ROOT / "impactsym" / "data" / "validation" / "small_overlap_barrier_tests.csv") as handle:
         measured = {row["test_id"]: row for row in csv.DictReader(handle)}
     for row in fusion_table:
         source = measured[row["test"]]

@@ -1,4 +1,4 @@
-"""The validation report (impactsym/validation.py) against published crash data.
+"""The validation report (impactsym.validation) against published crash data.
 
 Tolerances were chosen BEFORE running the models on the data (written into this
 file before the first run), with the reasoning beside each; where the data are
@@ -47,6 +47,7 @@ import math
 import pytest
 
 from impactsym import validation
+from impactsym.validation import iihs
 
 V2V = "rigid PIM (Brach's fits, approx. d, equal masses)"
 BOUNDS = {
@@ -257,8 +258,8 @@ def test_v2v_head_on_geometry_is_point_symmetric():
     as a and b) head-on, each struck on its left front, are the same crash seen
     from either car, so their |delta-V| and yaw-rate changes must be equal and the
     yaw counter-clockwise (toward the struck side) for both."""
-    a, _ = validation._v2v_tests()["CF11009"]
-    result = validation._v2v_solve((a, a))
+    a, _ = iihs.v2v_tests()["CF11009"]
+    result = iihs.v2v_solve((a, a))
     one, two = result.vehicles
     assert one.delta_v_magnitude == pytest.approx(two.delta_v_magnitude, rel=1e-9)
     assert one.yaw_rate == pytest.approx(two.yaw_rate, rel=1e-9)

@@ -14,7 +14,7 @@ import numpy as np
 
 from .. import _kernels
 from .._util import is_dataframe
-from ..casefile import unknown_key
+from ..scene.casefile import unknown_key
 
 #: Scene-file words for batch columns: a near miss of one suggests its column.
 _SCENE_WORDS = {

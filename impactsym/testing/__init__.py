@@ -5,5 +5,7 @@
 - `impactsym.testing.scenes`: generators of random and hard scenes as batch columns.
 
 Neither is imported by ``import impactsym``, and neither imports ``derive`` or
-``generated``: they check the generated kernels from outside.
+``generated``: they check the generated kernels from outside. Not in the wheel
+(pyproject.toml): they serve a checkout or an sdist, where mpmath comes with the
+``test`` extra.
 """

@@ -26,7 +26,7 @@ import functools
 import math
 from dataclasses import dataclass
 
-from ._util import require
+from .._util import require
 
 __all__ = [
     "DIMENSIONS",

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from .batch.quantiles import percentiles
+from ..batch.quantiles import percentiles
 
 __all__ = ["Uncertainty", "Stats", "KEEP", "HISTOGRAM_BINS", "PERCENTILES"]
 

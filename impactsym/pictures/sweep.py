@@ -16,10 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import _kernels
-from ._util import require
-from .codes import FLAG_ENERGY_CREATED, FLAG_MU_BEYOND_CRITICAL, FLAG_TENSILE_IMPULSE
-from .result import UNIT_LABELS
+from .. import _kernels
+from .._util import require
+from ..codes import FLAG_ENERGY_CREATED, FLAG_MU_BEYOND_CRITICAL, FLAG_TENSILE_IMPULSE
+from ..result import UNIT_LABELS
 
 __all__ = [
     "sweep",

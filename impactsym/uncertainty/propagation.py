@@ -50,12 +50,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _kernels
-from ._kernels import CODES as _codes
-from .batch.sweeps import BLOCK, CHUNK_SIZE, SamplePlan
-from .uncertainty_commands import COMMANDS, COMPLEX_STEP, RECONSTRUCT, Command, command_for
-from .uncertainty_inputs import Input, cholesky, correlation_matrix
-from .uncertainty_result import KEEP, Stats, Uncertainty
+from .. import _kernels
+from .._kernels import CODES as _codes
+from ..batch.sweeps import BLOCK, CHUNK_SIZE, SamplePlan
+from .commands import COMMANDS, COMPLEX_STEP, RECONSTRUCT, Command, command_for
+from .inputs import Input, cholesky, correlation_matrix
+from .result import KEEP, Stats, Uncertainty
 
 STATUS_NAMES = {getattr(_codes, n): n[len("STATUS_") :] for n in dir(_codes) if n.startswith("STATUS_")}
 FLAG_NAMES = {n[len("FLAG_") :]: getattr(_codes, n) for n in dir(_codes) if n.startswith("FLAG_")}
@@ -454,8 +454,8 @@ def scene_source(
 ) -> Source:
     """The Source of a scene (path, mapping or Scene) for a command; for
     crash3 with the scene's CRASH3 options overridden by those given."""
-    from .crash3 import crash3_options
-    from .scene import load_scene, scene_columns, scene_data
+    from ..crash3 import crash3_options
+    from ..scene import load_scene, scene_columns, scene_data
 
     kind = {"solve": "forward", "invert": "inverse", "reconstruct": "reconstruct", "crash3": "crash3"}.get(
         command

@@ -13,8 +13,8 @@ from __future__ import annotations
 import argparse
 import json
 
+from ..scene import SceneError
 from .propagation import uncertainty
-from .scene import SceneError
 
 DEFAULT_DRAWS = 10_000
 
@@ -57,7 +57,7 @@ def run(args: argparse.Namespace, command: str, result, **options) -> int:
     except (ValueError, ImportError) as exc:  # a one-line reason, exit code 2
         raise SceneError(str(exc)) from None
     if getattr(args, "plot", None):
-        from .uncertainty_plot import save_uncertainty_plot
+        from .plot import save_uncertainty_plot
 
         save_uncertainty_plot(u, args.plot)
     if args.json:

@@ -7,7 +7,7 @@ A *leaf* is one number of a scene, named by its path as written
 
 - a bare number, in the unit of the scene's ``units`` system (angles in degrees,
   yaw rates in rad/s);
-- a string with a unit (``"35 mph"``, ``"3451 lb"``; :mod:`impactsym.units`);
+- a string with a unit (``"35 mph"``, ``"3451 lb"``; :mod:`impactsym.scene.units`);
 - a distribution: ``{"normal": [mean, sd]}``, ``{"uniform": [low, high]}``,
   ``{"triangular": [low, mode, high]}``, each value a number or a unit string.
   The nominal value (mean, midpoint, mode) is what the plain commands solve.
@@ -27,7 +27,7 @@ Conventions: directions and headings are degrees counter-clockwise from +x;
 front points); in the vehicle frame ``forward`` is along the heading and
 ``left`` 90° counter-clockwise from it; ``angle`` is counter-clockwise from
 the heading (to the left). ``mass = weight / g_n`` with
-g_n = 9.80665 m/s² (:data:`impactsym.units.STANDARD_GRAVITY`).
+g_n = 9.80665 m/s² (:data:`impactsym.scene.units.STANDARD_GRAVITY`).
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import SceneError, show_value
+from ..errors import SceneError, show_value
 from .units import GRAVITY, to_scene_units
 
 __all__ = [

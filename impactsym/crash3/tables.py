@@ -34,7 +34,7 @@ __all__ = [
     "stiffness",
 ]
 
-DATA = Path(__file__).resolve().parent / "data"
+DATA = Path(__file__).resolve().parent.parent / "data"
 FACES = ("front", "rear", "side")
 CATEGORIES = tuple(range(1, 10))
 LBF = 4.4482216152605  # N per pound-force (exact by definition)

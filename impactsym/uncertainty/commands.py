@@ -16,10 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _kernels
-from .batch import solve_batch
-from .inverse import invert_batch
-from .reconstruct import reconstruct_batch
+from .. import _kernels
+from ..batch import solve_batch
+from ..inverse import invert_batch
+from ..reconstruct import reconstruct_batch
 
 __all__ = ["Command", "RECONSTRUCT", "command_for", "COMMANDS", "COMPLEX_STEP"]
 
@@ -170,7 +170,7 @@ def _crash3_stages(c: Mapping, options, units: str, tangents: list | None = None
     energy. With `tangents` (per input, d column) the exact Jacobian kernels
     of each stage carry them through too (one scene). Returns (values by
     name, status, per-input tangents by name)."""
-    from .crash3 import CORRECTED_OUTPUT, DELTA_V_KERNELS, ENERGY_FACTOR
+    from ..crash3.model import CORRECTED_OUTPUT, DELTA_V_KERNELS, ENERGY_FACTOR
 
     factor = ENERGY_FACTOR[units]
     corrected = CORRECTED_OUTPUT[options.correction]
@@ -334,7 +334,7 @@ def command_for(
     restitution, ``energy`` "dissipated" | "absorbed" and ``correction``
     "crash3" | "woolley", as `impactsym.crash3`)."""
     if command == "crash3":
-        from .crash3 import Crash3Options
+        from ..crash3 import Crash3Options
 
         return _crash3_command(units, Crash3Options(restitution, energy, correction))
     if command == "solve":

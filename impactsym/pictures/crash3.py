@@ -21,9 +21,9 @@ import math
 from pathlib import Path
 from typing import Any
 
-from ._util import require
-from .crash3 import Crash3Result, crush_tables
-from .result import UNIT_LABELS
+from .._util import require
+from ..crash3 import Crash3Result, crush_tables
+from ..result import UNIT_LABELS
 
 __all__ = ["crash3_figure", "save_crash3"]
 

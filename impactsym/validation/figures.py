@@ -1,0 +1,130 @@
+"""Predicted-versus-measured plots of the validation report (needs matplotlib)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .common import Comparison, Dataset
+from .iihs import V2V_MODEL
+from .ricsac import OTHER_PIM_MODELS
+
+# Per dataset, the plots: (panel title, reference, [(model, quantity), ...]).
+PLOTS = {
+    "ricsac": [
+        (
+            "delta-V [m/s] vs measured (Brach & Smith 2002)",
+            "measured, Brach & Smith 2002",
+            [
+                ("CRASH3 (published profiles)", "delta-V"),
+                ("CRASH3 (Neades' adjustments)", "delta-V"),
+                ("rigid PIM (approx. impact centre)", "delta-V"),
+                (OTHER_PIM_MODELS["limpert"], "delta-V"),
+            ],
+        ),
+        (
+            "energy loss [ft lb] vs measured",
+            None,
+            [
+                ("CRASH3 (published profiles)", "energy loss", "measured"),
+                ("CRASH3 (Neades' adjustments)", "energy loss", "measured"),
+                ("rigid PIM (approx. impact centre)", "energy loss", "measured"),
+            ],
+        ),
+    ],
+    "iihs": [
+        ("delta-V [ft/s] vs measured", "measured", [("rigid PIM (Brach's fits)", "delta-V")]),
+        (
+            "yaw-rate change [deg/s] vs measured",
+            "measured",
+            [("rigid PIM (Brach's fits)", "yaw-rate change")],
+        ),
+    ],
+    "iihs_v2v": [
+        (
+            "|delta-V| [ft/s] vs measured",
+            None,
+            [(V2V_MODEL, "delta-V", f"measured, {kind}") for kind in ("sideswipe", "non-sideswipe")],
+        ),
+        (
+            "yaw-rate change [deg/s] vs measured",
+            None,
+            [(V2V_MODEL, "yaw-rate change", f"measured, {kind}") for kind in ("sideswipe", "non-sideswipe")],
+        ),
+    ],
+    "nhtsa": [
+        (
+            "delta-V [mph]",
+            None,
+            [("rigid PIM", "delta-V", "published PIM"), ("rigid PIM", "delta-V", "measured")],
+        ),
+        ("final yaw rate [deg/s] vs published PIM", "published PIM", [("rigid PIM", "final yaw rate")]),
+        (
+            "energy loss [ft lb] vs published PIM",
+            "published PIM",
+            [
+                ("rigid PIM", "energy loss"),
+                ("rigid PIM", "normal energy loss"),
+                ("rigid PIM", "tangential energy loss"),
+            ],
+        ),
+    ],
+}
+
+
+def _find(ds: Dataset, model: str, quantity: str, reference: str) -> Comparison:
+    return next(
+        c for c in ds.comparisons if (c.model, c.quantity, c.reference) == (model, quantity, reference)
+    )
+
+
+def plot(datasets: list[Dataset], directory: Path | str) -> list[Path]:
+    """Predicted-versus-measured plots with the 1:1 line, one PNG per dataset
+    saved in `directory` (needs matplotlib); returns the paths."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for ds in datasets:
+        panels = PLOTS[ds.name]
+        fig, axes = plt.subplots(1, len(panels), figsize=(5.2 * len(panels), 4.6), squeeze=False)
+        for ax, (title, reference, series) in zip(axes[0], panels):
+            top = 0.0
+            comps = [_find(ds, e[0], e[1], e[2] if len(e) > 2 else reference) for e in series]
+            mixed_q = len({c.quantity for c in comps}) > 1
+            mixed_r = len({c.reference for c in comps}) > 1
+            # One model against several references: the model in the title, the
+            # references in the legend.
+            by_reference = mixed_r and not mixed_q and len({c.model for c in comps}) == 1
+            if by_reference:
+                title = f"{title}\n{comps[0].model}"
+            for comp in comps:
+                xs, ys = [r for _, _, r in comp.rows], [m for _, m, _ in comp.rows]
+                label = (
+                    comp.reference
+                    if by_reference
+                    else comp.model
+                    + (f", {comp.quantity}" if mixed_q else "")
+                    + (f" vs {comp.reference}" if mixed_r else "")
+                )
+                ax.scatter(
+                    xs, ys, s=22, alpha=0.8, label=f"{label} (median |err| {comp.stats()['median']:.1f} %)"
+                )
+                top = max(top, *xs, *ys)
+            ax.ticklabel_format(style="sci", scilimits=(-3, 4))
+            ax.plot([0, top * 1.05], [0, top * 1.05], "k--", lw=1, label="1:1")
+            ax.set_xlabel("reference")
+            ax.set_ylabel("model")
+            ax.set_title(title, fontsize=10)
+            ax.legend(fontsize=7)
+            ax.set_aspect("equal", adjustable="box")
+        fig.suptitle(ds.title, fontsize=11)
+        fig.tight_layout()
+        path = directory / f"{ds.name}.png"
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        paths.append(path)
+    return paths
