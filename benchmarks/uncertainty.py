@@ -98,8 +98,8 @@ def _best(func, repeat: int = 3) -> float:
 
 
 def end_to_end(draws: int) -> dict:
-    from impactsym.uncertainty import propagation as U
     from impactsym import reconstruct_batch
+    from impactsym.uncertainty import propagation as U
 
     src = source()
     U.propagate(src, draws=1 << 16, seed=1)  # compile and warm up

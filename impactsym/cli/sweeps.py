@@ -8,8 +8,6 @@ import json
 
 import numpy as np
 
-from ..codes import describe_status
-from ..result import UNIT_LABELS, json_clean, json_number, table_cell
 from ..batch.sweeps import (
     CHUNK_SIZE,
     PERCENTILES,
@@ -22,6 +20,8 @@ from ..batch.sweeps import (
     write_frame,
 )
 from ..batch.sweeps import sweep as solve_sweep
+from ..codes import describe_status
+from ..result import UNIT_LABELS, json_clean, json_number, table_cell
 from .common import UsageError, _api_errors
 
 _OUTPUT_TIERS = ("all", "velocities", "impulses", "energy")
