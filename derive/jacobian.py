@@ -45,12 +45,13 @@ def _tangent_symbol(sym: sp.Symbol, wrt: sp.Symbol) -> sp.Symbol:
     return real(derivative_name(Kernel.public_name(sym), wrt.name))
 
 
-def jacobian_kernel(base: Kernel, name: str | None = None) -> Kernel:
-    """`base` plus the exact derivatives of its outputs with respect to its inputs.
+def jacobian_kernel(base: Kernel, name: str | None = None, wrt: tuple | None = None) -> Kernel:
+    """`base` plus the exact derivatives of its outputs with respect to its inputs
+    (or to the inputs `wrt` only).
 
     Blocks that only feed the physics flags (the flag tolerances, sums of
     absolute values) get no derivative blocks: no output depends on them."""
-    wrt = tuple(base.inputs)
+    wrt = tuple(base.inputs) if wrt is None else tuple(wrt)
     tangents = {x: {x: sp.Integer(1)} for x in wrt}
     needed = _needed_by_outputs(base)
     blocks = []
