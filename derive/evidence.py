@@ -159,7 +159,10 @@ def _linear_kernel() -> Kernel:
         name="evidence_linear",
         doc="Observations linear in the state (v, w, P, M): speeds, finals, delta-V.",
         inputs=params + STATE,
-        checks=(finite_inputs(ARMS + (theta1, theta2, a1, b1, a2, b2, e_m) + STATE, MASSES), positive_or_fixed(MASSES)),
+        checks=(
+            finite_inputs(ARMS + (theta1, theta2, a1, b1, a2, b2, e_m) + STATE, MASSES),
+            positive_or_fixed(MASSES),
+        ),
         blocks=blocks,
         outputs=outputs,
     )
@@ -274,7 +277,9 @@ def _derived_kernel() -> Kernel:
         + planar.critical_ratio_blocks()
         + (Block(((TL, TLn + TLt + TLm),), equation="TL = TLn + TLt + TLm (conventions.md energy)"),)
     )
-    tolerances, flags = f.physics_flags((TL, TLn, TLt, TLm), ((Pn, gn), (Pt, gt), (M, wr)), mu_used=mu, restitution=e)
+    tolerances, flags = f.physics_flags(
+        (TL, TLn, TLt, TLm), ((Pn, gn), (Pt, gt), (M, wr)), mu_used=mu, restitution=e
+    )
     return Kernel(
         name="evidence_derived",
         doc="Coefficients a state implies: e, mu, mu_c, Pn, Pt, the energy partition, physics flags.",
@@ -319,7 +324,9 @@ def _linear_holds() -> list:
             I2 * (got[W2] - w2) + (r2x * Py - r2y * Px) + M,
         )
     )
-    restitution = sp.simplify(got[R_em] - ((got[W2] - got[W1]) * (1 - e_m) - e_m * M * (1 / I1 + 1 / I2))) == 0
+    restitution = (
+        sp.simplify(got[R_em] - ((got[W2] - got[W1]) * (1 - e_m) - e_m * M * (1 / I1 + 1 / I2))) == 0
+    )
     # The point rho = a h + b h_perp of each body: its velocity change dV + dW (-rho_y, rho_x),
     # projected on h and h_perp.
     module = True
@@ -338,7 +345,10 @@ def _linear_holds() -> list:
     return [
         ("evidence_linear: V_i, W_i satisfy the six equations 1 and 2 (momentum, angular impulse)", six),
         ("evidence_linear: R_em is the moment restitution residual (six equations 5)", restitution),
-        ("evidence_linear: module delta-V is the velocity change of the body point (a, b), in the vehicle axes", module),
+        (
+            "evidence_linear: module delta-V is the velocity change of the body point (a, b), in the vehicle axes",
+            module,
+        ),
         ("evidence_linear: s_i = h_i . v_i", speeds),
         ("evidence_linear: every output is linear in the state (all second derivatives 0)", linear),
     ]
@@ -445,8 +455,15 @@ def proofs():
     """(claim, passed) for the observation equations and their Jacobians."""
     rng = random.Random(20261124)
     claims = _linear_holds()
-    claims.append(("evidence_energy: TL = kinetic energy before - after (finals from the six equations)", _energy_holds()))
-    claims.append(("evidence_vector: |a| (cos, sin)(direction) = a in all four quadrants", _vector_holds(rng)))
+    claims.append(
+        (
+            "evidence_energy: TL = kinetic energy before - after (finals from the six equations)",
+            _energy_holds(),
+        )
+    )
+    claims.append(
+        ("evidence_vector: |a| (cos, sin)(direction) = a in all four quadrants", _vector_holds(rng))
+    )
     claims.append(
         (
             "evidence_derived: at forward rigid solutions the state gives back e, mu, mu_c, TL, TLn, TLt; "

@@ -1,0 +1,364 @@
+"""Reading a fit scene: the vehicles, the optional impact block and the evidence.
+
+A fit scene (conventions.md, "Reconstruction from evidence") is a scene whose
+vehicles carry ``mass``, ``yaw_inertia``, ``impact_point`` and ``heading``
+(pre-impact direction of travel and orientation, degrees) and whose
+``evidence`` list holds the observations, each with its standard deviation.
+Numbers take units as in any scene (impactsym.casefile); the result is in the
+scene's system (SI: m/s, rad/s, J; US: ft/s, rad/s, ft·lb). Angles are kept
+in radians here.
+
+Unknowns (the state is z = (v1x, v1y, w1, v2x, v2y, w2, Px, Py, M)):
+- a vehicle that gives ``velocity`` has a known pre-impact velocity; otherwise
+  its speed along its heading is unknown (``vehicles[i].speed``);
+- its pre-impact yaw rate is its ``yaw_rate`` (default 0), unknown only when it
+  gives none and the evidence lists a ``yaw_rate`` of it;
+- the impulse (Px, Py) is always unknown; the moment impulse M only when
+  ``impact.moment_restitution`` is given (then moment restitution is an exact
+  constraint); otherwise M = 0 (a point impulse).
+A fixed vehicle (a barrier) has no unknowns.
+
+Bad input is a :class:`SceneError` naming the field (one line).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..casefile import (
+    IMPACT_KEYS,
+    TOP_KEYS,
+    VEHICLE_KEYS,
+    LeafReader,
+    check_keys,
+    used_normal_angle,
+    vehicle_state,
+)
+from ..errors import SceneError, show_value
+from ..scene import scene_data
+
+STATE = ("v1x", "v1y", "w1", "v2x", "v2y", "w2", "Px", "Py", "M")
+EVIDENCE_KEYS = ("vehicle", "quantity", "value", "sd", "at", "edr", "lateral_positive", "module", "note")
+#: quantity -> (dimension of its value, needs a vehicle)
+QUANTITIES = {
+    "speed": ("speed", True),
+    "final_speed": ("speed", True),
+    "final_direction": ("angle", True),
+    "final_velocity": ("speed", True),
+    "yaw_rate": ("rate", True),
+    "final_yaw_rate": ("rate", True),
+    "delta_v": ("speed", True),
+    "delta_v_longitudinal": ("speed", True),
+    "delta_v_lateral": ("speed", True),
+    "energy_loss": ("energy", False),
+    "crush_energy": ("energy", True),
+    "rest": (None, True),
+}
+ENERGY_UNIT = {"SI": "J", "US": "ft*lbf"}
+
+
+@dataclass(frozen=True)
+class Observation:
+    """One scalar observation: evidence item `evidence`, its `label`, the
+    value and sd in scene units (angles in radians), and how the model
+    computes it: ``("linear", output, (a, b))`` (an output of evidence_linear
+    with that vehicle's module at (a, b)), ``("state", name)``,
+    ``("norm" | "direction", (x_output, y_output))``, ``("energy",)``."""
+
+    evidence: int
+    label: str
+    value: float
+    sd: float
+    how: tuple
+    angle: bool = False
+
+
+@dataclass
+class FitCase:
+    """A fit scene read: kernel parameters, the affine map z = z0 + T x from
+    the unknowns x to the state, the unknowns' output paths, observations."""
+
+    units: str
+    names: tuple[str, str]
+    params: dict
+    z0: np.ndarray
+    T: np.ndarray
+    unknowns: list[str]
+    observations: list[Observation]
+    has_normal: bool
+    moment: bool
+    fixed: tuple[bool, bool]
+    headings: tuple[float, float]
+    warnings: list[str] = field(default_factory=list)
+
+
+def read_case(source: Mapping | str | Path) -> FitCase:
+    """Read and check a fit scene (a mapping or a .json/.toml path)."""
+    data = scene_data(source)
+    if not isinstance(data, Mapping):
+        raise SceneError(f"a scene must be an object, got {show_value(data)}")
+    check_keys(data, (*TOP_KEYS, "evidence"), "")
+    units = data.get("units")
+    if units not in ("SI", "US"):
+        raise SceneError(f'must be "SI" or "US", got {show_value(units)}', "units")
+    if data.get("model", "rigid") not in ("rigid", "brach"):
+        raise SceneError("fit uses the rigid model (point impulse at the impact centre)", "model")
+    leaves = LeafReader(units)
+    vehicles = data.get("vehicles")
+    if not isinstance(vehicles, list) or len(vehicles) != 2:
+        raise SceneError(f"must be a list of exactly 2 vehicles, got {show_value(vehicles)}", "vehicles")
+    fixed = tuple(_read_vehicle(v, i, leaves) for i, v in enumerate(vehicles))
+    if all(fixed):
+        raise SceneError("both vehicles are fixed; at most one may be", "vehicles")
+    impact = data.get("impact", {})
+    if not isinstance(impact, Mapping):
+        raise SceneError(f"must be an object, got {show_value(impact)}", "impact")
+    check_keys(impact, IMPACT_KEYS, "impact")
+    warnings = [
+        f"impact.{k} is given but not used: a fit infers it"
+        for k in ("restitution", "impulse_ratio")
+        if k in impact
+    ]
+    if "normal_angle" in impact:
+        leaves.number(impact["normal_angle"], "impact.normal_angle", "angle")
+    if "moment_restitution" in impact:
+        leaves.number(impact["moment_restitution"], "impact.moment_restitution", "number")
+    values = {path: leaf.nominal for path, leaf in leaves.leaves.items()}
+    if any(leaf.kind is not None for leaf in leaves.leaves.values()):
+        raise SceneError("fit takes plain numbers for the vehicles and impact (evidence carries the sd)")
+    states = [vehicle_state(values, i, units) for i in range(2)]
+    params, z0, columns, unknowns = _state_map(states, fixed, values)
+    has_normal = "impact.normal_angle" in values
+    if has_normal:
+        angle, flipped = used_normal_angle(values["impact.normal_angle"], states[0]["r"], states[1]["r"])
+        params["gamma"] = math.radians(float(angle))
+        if flipped:
+            warnings.append(f"impact.normal_angle is turned round to {float(angle):g} deg (n·(r1 - r2) > 0)")
+    else:
+        params["gamma"] = 0.0
+    moment = "impact.moment_restitution" in values
+    params["e_m"] = values.get("impact.moment_restitution", 1.0)
+    if moment:
+        columns.append(_unit(8))
+        unknowns.append("impulse.moment")
+    names = tuple(str(v.get("name", f"vehicle {i + 1}")) for i, v in enumerate(vehicles))
+    raw = data.get("evidence")
+    if not isinstance(raw, list) or not raw:
+        raise SceneError(f"must be a non-empty list of evidence items, got {show_value(raw)}", "evidence")
+    observations = []
+    for k, item in enumerate(raw):
+        observations += read_item(item, k, units, names, fixed, source)
+    yaw_observed = {o.how[1] for o in observations if o.how[0] == "state"}
+    for i in range(2):
+        if f"w{i + 1}" in yaw_observed and f"vehicles[{i}].yaw_rate" not in values and not fixed[i]:
+            columns.append(_unit(3 * i + 2))
+            unknowns.append(f"vehicles[{i}].yaw_rate")
+    T = np.array(columns, dtype=float).T if columns else np.zeros((9, 0))
+    headings = tuple(math.radians(s["heading"] or 0.0) for s in states)
+    return FitCase(
+        units, names, params, z0, T, unknowns, observations, has_normal, moment, fixed, headings, warnings
+    )
+
+
+def _unit(index: int) -> np.ndarray:
+    column = np.zeros(9)
+    column[index] = 1.0
+    return column
+
+
+def _read_vehicle(entry: Any, index: int, leaves: LeafReader) -> bool:
+    """Check vehicle `index` and record its leaves; True when it is fixed."""
+    path = f"vehicles[{index}]"
+    if not isinstance(entry, Mapping):
+        raise SceneError(f"must be an object, got {show_value(entry)}", path)
+    check_keys(entry, VEHICLE_KEYS, path)
+    fixed = entry.get("fixed", False)
+    if not isinstance(fixed, bool):
+        raise SceneError(f"must be true or false, got {show_value(fixed)}", f"{path}.fixed")
+    if not fixed:
+        for key, alt in (("mass", "weight"), ("yaw_inertia", "radius_of_gyration"), ("impact_point", None)):
+            if key not in entry and (alt is None or alt not in entry):
+                raise SceneError("missing", f"{path}.{key}")
+        if "heading" not in entry:
+            raise SceneError(
+                "missing (the pre-impact direction of travel and orientation)", f"{path}.heading"
+            )
+    for key, dimension in (
+        ("mass", "mass"),
+        ("weight", "force"),
+        ("yaw_inertia", "inertia"),
+        ("radius_of_gyration", "length"),
+    ):
+        if key in entry:
+            leaves.number(entry[key], f"{path}.{key}", dimension, "positive")
+    for key, dimension in (("yaw_rate", "rate"), ("heading", "angle")):
+        if key in entry:
+            leaves.number(entry[key], f"{path}.{key}", dimension)
+    if "velocity" in entry:
+        leaves.vector(entry["velocity"], f"{path}.velocity", "speed", "velocity")
+    if "impact_point" in entry:
+        leaves.vector(entry["impact_point"], f"{path}.impact_point", "length", "impact_point")
+    for key in ("final_velocity", "final_yaw_rate", "crush", "length", "width"):
+        if key in entry:
+            raise SceneError("not read by fit: give it as an evidence item with its sd", f"{path}.{key}")
+    return fixed
+
+
+def _state_map(states, fixed, values):
+    """Kernel parameters, the known state z0 and the unknowns' columns of T."""
+    params, z0, columns, unknowns = {}, np.zeros(9), [], []
+    for i, (state, is_fixed) in enumerate(zip(states, fixed)):
+        n = i + 1
+        params[f"m{n}"] = math.inf if is_fixed else float(state["m"])
+        params[f"I{n}"] = math.inf if is_fixed else float(state["I"])
+        params[f"r{n}x"], params[f"r{n}y"] = (float(c) for c in state["r"])
+        params[f"theta{n}"] = math.radians(state["heading"] or 0.0)
+        if is_fixed:
+            continue
+        z0[3 * i + 2] = float(state["w"])
+        if state["v"] is not None:
+            z0[3 * i], z0[3 * i + 1] = (float(c) for c in state["v"])
+        else:
+            column = np.zeros(9)
+            column[3 * i], column[3 * i + 1] = math.cos(params[f"theta{n}"]), math.sin(params[f"theta{n}"])
+            columns.append(column)
+            unknowns.append(f"vehicles[{i}].speed")
+    columns += [_unit(6), _unit(7)]
+    unknowns += ["impulse.x", "impulse.y"]
+    return params, z0, columns, unknowns
+
+
+def _vehicle_index(raw: Any, names, path: str) -> int:
+    if isinstance(raw, bool) or raw is None:
+        raise SceneError(f"must be 0, 1 or a vehicle's name, got {show_value(raw)}", path)
+    if isinstance(raw, int) and raw in (0, 1):
+        return raw
+    if isinstance(raw, str) and raw in names:
+        return names.index(raw)
+    raise SceneError(f"unknown vehicle {show_value(raw)} (use 0, 1 or one of {', '.join(names)})", path)
+
+
+def _scalar(value: Any, path: str, dimension: str, units: str, domain: str = "any") -> float:
+    """One number in scene units (angles in degrees, as given), or a one-line error."""
+    if isinstance(value, Mapping):
+        raise SceneError("an evidence value is a number (its uncertainty is the sd)", path)
+    if dimension == "energy":
+        return _energy(value, path, units, domain)
+    return LeafReader(units).number(value, path, dimension, domain)
+
+
+def _energy(value: Any, path: str, units: str, domain: str) -> float:
+    from ..units import registry
+
+    if isinstance(value, str):
+        try:
+            number = float(registry().Quantity(value).to(ENERGY_UNIT[units]).magnitude)
+        except Exception as exc:  # pint raises several kinds; the message is what matters
+            raise SceneError(f"needs an energy (J, ft*lbf, kJ), got {value!r} ({exc})", path) from None
+    elif isinstance(value, (int, float)) and not isinstance(value, bool):
+        number = float(value)
+    else:
+        raise SceneError(f"must be a number (or a number with a unit), got {show_value(value)}", path)
+    if not math.isfinite(number) or (domain == "positive" and number <= 0):
+        raise SceneError(
+            f"must be a {'positive ' if domain == 'positive' else ''}finite number, got {show_value(value)}",
+            path,
+        )
+    return number
+
+
+def _sds(raw: Any, path: str, dimension: str, units: str, count: int) -> list[float]:
+    if raw is None:
+        raise SceneError("missing (every evidence item needs its standard deviation)", path)
+    if count == 2 and isinstance(raw, list):
+        if len(raw) != 2:
+            raise SceneError(f"must be a number or a pair, got {show_value(raw)}", path)
+        return [_scalar(x, f"{path}[{j}]", dimension, units, "positive") for j, x in enumerate(raw)]
+    return [_scalar(raw, path, dimension, units, "positive")] * count
+
+
+def read_item(item: Any, k: int, units: str, names, fixed, source=None) -> list[Observation]:
+    """The scalar observations of evidence item `k`."""
+    path = f"evidence[{k}]"
+    if not isinstance(item, Mapping):
+        raise SceneError(f"must be an object, got {show_value(item)}", path)
+    check_keys(item, EVIDENCE_KEYS, path)
+    if "edr" in item:
+        from .edr_item import edr_observations
+
+        return edr_observations(item, k, units, names, fixed, source)
+    quantity = item.get("quantity")
+    if quantity not in QUANTITIES:
+        raise SceneError(
+            f"unknown quantity {show_value(quantity)} (known: {', '.join(QUANTITIES)})", f"{path}.quantity"
+        )
+    dimension, per_vehicle = QUANTITIES[quantity]
+    if quantity == "rest":
+        raise SceneError(
+            "a rest pose as evidence needs the run-out, which this build does not have yet", f"{path}.quantity"
+        )
+    i = _vehicle_index(item.get("vehicle"), names, f"{path}.vehicle") if per_vehicle else None
+    if per_vehicle and fixed[i]:
+        raise SceneError("vehicle is fixed: it has no motion to observe", f"{path}.vehicle")
+    if "value" not in item:
+        raise SceneError("missing", f"{path}.value")
+    n = None if i is None else i + 1
+    module = _module(item, path, units) if quantity.startswith("delta_v_") else (0.0, 0.0)
+    if "at" in item and not quantity.startswith("delta_v_"):
+        raise SceneError("only delta_v_longitudinal and delta_v_lateral are read at a module", f"{path}.at")
+    if quantity == "final_velocity":
+        value = item["value"]
+        if not isinstance(value, list) or len(value) != 2:
+            raise SceneError(f"must be [x, y], got {show_value(value)}", f"{path}.value")
+        vals = [_scalar(x, f"{path}.value[{j}]", dimension, units) for j, x in enumerate(value)]
+        sds = _sds(item.get("sd"), f"{path}.sd", dimension, units, 2)
+        return [
+            Observation(
+                k, f"vehicles[{i}].final_velocity[{j}]", vals[j], sds[j], ("linear", f"V{n}{c}", (0.0, 0.0))
+            )
+            for j, c in enumerate("xy")
+        ]
+    value = _scalar(item["value"], f"{path}.value", dimension, units)
+    (sd,) = _sds(item.get("sd"), f"{path}.sd", dimension, units, 1)
+    if dimension == "angle":
+        value, sd = math.radians(value), math.radians(sd)
+    how = {
+        "speed": ("linear", f"s{n}", (0.0, 0.0)),
+        "final_speed": ("norm", (f"V{n}x", f"V{n}y")),
+        "final_direction": ("direction", (f"V{n}x", f"V{n}y")),
+        "yaw_rate": ("state", f"w{n}"),
+        "final_yaw_rate": ("linear", f"W{n}", (0.0, 0.0)),
+        "delta_v": ("norm", (f"dV{n}x", f"dV{n}y")),
+        "delta_v_longitudinal": ("linear", f"dl{n}", module),
+        "delta_v_lateral": ("linear", f"dt{n}", module),
+        "energy_loss": ("energy",),
+        "crush_energy": ("energy",),
+    }[quantity]
+    if quantity == "crush_energy" and not fixed[1 - i]:
+        raise SceneError(
+            "one vehicle's crush energy is the energy loss only against a fixed barrier; with two "
+            "moving vehicles give energy_loss (the CRASH3 total of both, crash3 --json energy_total)",
+            f"{path}.quantity",
+        )
+    label = (
+        "energy_loss.total" if quantity in ("energy_loss", "crush_energy") else f"vehicles[{i}].{quantity}"
+    )
+    return [Observation(k, label, value, sd, how, angle=dimension == "angle")]
+
+
+def _module(item: Mapping, path: str, units: str) -> tuple[float, float]:
+    """The module position (forward, left) from the centre of gravity: ``at`` (or ``module``)."""
+    raw = item.get("at", item.get("module"))
+    if raw is None:
+        return (0.0, 0.0)
+    key = "at" if "at" in item else "module"
+    if not isinstance(raw, Mapping):
+        raise SceneError(f"must be {{forward, left}}, got {show_value(raw)}", f"{path}.{key}")
+    check_keys(raw, ("forward", "left"), f"{path}.{key}")
+    return tuple(_scalar(raw.get(c, 0.0), f"{path}.{key}.{c}", "length", units) for c in ("forward", "left"))

@@ -1,0 +1,327 @@
+"""`fit(scene)`: the pre-impact motion from whatever evidence a scene lists.
+
+The answer (conventions.md, "Reconstruction from evidence") holds every
+quantity the evidence determines with its 90 % interval, and null for every
+quantity it does not determine, with the reason (the direction in unknown
+space no evidence reaches). Admissibility (T_L ≥ 0, a compressive normal
+impulse, 0 ≤ e ≤ 1, μ between 0 and μ_c) is checked as flags on the answer,
+not imposed as constraints: evidence that calls for an impossible impact is
+shown, not bent. Units are the scene's (angles in degrees).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..codes import describe_flags, describe_status
+from ..result import json_number
+from .case import STATE, FitCase, read_case
+from .model import Model, energy_loss
+from .solve import Z90, Identifiability, fit_case
+
+#: Flag bits of evidence_derived (conventions.md) and the quantities each needs determined.
+FLAG_NEEDS = {
+    1: ("energy_loss.total",),
+    2: ("impulse.normal",),
+    4: ("impulse_ratio", "critical_impulse_ratio"),
+    8: ("restitution",),
+}
+DERIVED = {
+    "impulse.normal": "Pn",
+    "impulse.tangential": "Pt",
+    "restitution": "e",
+    "impulse_ratio": "mu",
+    "critical_impulse_ratio": "mu_c",
+}
+NO_NORMAL = (
+    "needs impact.normal_angle: the impulse (Px, Py) does not say how it splits into normal and "
+    "tangential parts"
+)
+ENERGY_PARTS = {"energy_loss.normal": "TLn", "energy_loss.tangential": "TLt", "energy_loss.moment": "TLm"}
+
+
+def quantities(model: Model, x, gradients: bool = True) -> dict:
+    """path -> (value, gradient in x or None, affine) at unknowns x."""
+    case = model.case
+    z = model.state(x)
+    q = {}
+
+    def affine(path, output):
+        a, b = model.affine(output)
+        q[path] = (a + b @ z, b @ case.T, True)
+
+    for i in range(2):
+        n = i + 1
+        affine(f"vehicles[{i}].speed", f"s{n}")
+        for j, c in enumerate("xy"):
+            row = 3 * i + j
+            q[f"vehicles[{i}].velocity[{j}]"] = (z[row], case.T[row], True)
+            affine(f"vehicles[{i}].final_velocity[{j}]", f"V{n}{c}")
+            affine(f"vehicles[{i}].delta_v[{j}]", f"dV{n}{c}")
+        q[f"vehicles[{i}].yaw_rate"] = (z[3 * i + 2], case.T[3 * i + 2], True)
+        affine(f"vehicles[{i}].final_yaw_rate", f"W{n}")
+        size, _, grad = model.vector(x, (f"dV{n}x", f"dV{n}y"), gradients)
+        q[f"vehicles[{i}].delta_v_magnitude"] = (size, grad, False)
+    for j, name in enumerate(("x", "y", "moment")):
+        q[f"impulse.{name}"] = (z[6 + j], case.T[6 + j], True)
+    total, grad = energy_loss(model, x, gradients)
+    q["energy_loss.total"] = (total, grad, False)
+    if case.has_normal:
+        out = model.derived(x, gradients)
+        for path, name in {**DERIVED, **ENERGY_PARTS}.items():
+            value = out[name] if out["status"] == 0 else math.nan
+            q[path] = (value, out.get(f"grad_{name}"), path.startswith("impulse."))
+        q["_derived"] = out
+    return q
+
+
+@dataclass
+class Estimate:
+    """One quantity: its estimate, sd and 90 % interval, or why it is not determined."""
+
+    value: float | None
+    sd: float | None = None
+    interval: tuple[float, float] | None = None
+    determined: bool = True
+    why: str = ""
+
+
+@dataclass
+class FitResult:
+    """The fitted impact (scene units; angles in degrees)."""
+
+    units: str
+    names: tuple[str, str]
+    estimates: dict[str, Estimate]
+    unknowns: list[str]
+    rank: int
+    condition: float
+    null_space: list[dict]
+    residuals: list[dict]
+    flags: int
+    info: dict
+    warnings: list[str] = field(default_factory=list)
+    kind = "fit"
+
+    def value(self, path: str):
+        est = self.estimates[path]
+        return json_number(est.value) if est.determined and est.value is not None else None
+
+    def to_json_dict(self) -> dict[str, Any]:
+        """The object ``impactsym fit --json`` prints (conventions.md)."""
+        vehicles = []
+        for i, name in enumerate(self.names):
+            p = f"vehicles[{i}]"
+            speed = self.estimates[f"{p}.speed"]
+            vehicles.append(
+                {
+                    "name": name,
+                    "speed": self.value(f"{p}.speed"),
+                    "speed_sd": json_number(speed.sd) if speed.determined and speed.sd is not None else None,
+                    "speed_interval": [json_number(v) for v in speed.interval]
+                    if speed.determined and speed.interval
+                    else None,
+                    "velocity": [self.value(f"{p}.velocity[{j}]") for j in range(2)],
+                    "yaw_rate": self.value(f"{p}.yaw_rate"),
+                    "final_velocity": [self.value(f"{p}.final_velocity[{j}]") for j in range(2)],
+                    "final_yaw_rate": self.value(f"{p}.final_yaw_rate"),
+                    "delta_v": [self.value(f"{p}.delta_v[{j}]") for j in range(2)],
+                    "delta_v_magnitude": self.value(f"{p}.delta_v_magnitude"),
+                }
+            )
+        has = self.estimates.get
+        return {
+            "units": self.units,
+            "vehicles": vehicles,
+            "impulse": {
+                "x": self.value("impulse.x"),
+                "y": self.value("impulse.y"),
+                "normal": self.value("impulse.normal") if has("impulse.normal") else None,
+                "tangential": self.value("impulse.tangential") if has("impulse.tangential") else None,
+                "moment": self.value("impulse.moment"),
+            },
+            "restitution": self.value("restitution") if has("restitution") else None,
+            "impulse_ratio": self.value("impulse_ratio") if has("impulse_ratio") else None,
+            "critical_impulse_ratio": self.value("critical_impulse_ratio")
+            if has("critical_impulse_ratio")
+            else None,
+            "energy_loss": {
+                part: (self.value(f"energy_loss.{part}") if has(f"energy_loss.{part}") else None)
+                for part in ("total", "normal", "tangential", "moment")
+            },
+            "identifiability": {
+                "unknowns": list(self.unknowns),
+                "rank": self.rank,
+                "condition": json_number(self.condition),
+                "determined": [p for p, e in self.estimates.items() if e.determined],
+                "not_determined": [p for p, e in self.estimates.items() if not e.determined],
+                "why": {p: e.why for p, e in self.estimates.items() if not e.determined},
+                "null_space": self.null_space,
+            },
+            "estimates": {
+                p: {
+                    "value": self.value(p),
+                    "sd": json_number(e.sd) if e.determined and e.sd is not None else None,
+                    "interval": [json_number(v) for v in e.interval] if e.determined and e.interval else None,
+                    "determined": e.determined,
+                }
+                for p, e in self.estimates.items()
+            },
+            "residuals": self.residuals,
+            "admissibility": {
+                "checked_as": "flags",
+                "flags": self.flags,
+                "violations": describe_flags(self.flags),
+            },
+            "method": self.info,
+            "warnings": list(self.warnings),
+        }
+
+    def table(self) -> str:
+        from .report import table
+
+        return table(self)
+
+
+def fit(scene: Mapping | str | Path, draws: int = 400, seed: int = 0, method: str = "auto") -> FitResult:
+    """Fit the impact model to a scene's evidence (conventions.md,
+    "Reconstruction from evidence"). `draws` Monte Carlo draws over the
+    evidence give the intervals of nonlinear quantities (0: none); `method`
+    ``"auto"`` (closed form on linear evidence) or ``"gauss-newton"``.
+    Raises SceneError (one line) for bad input."""
+    case = read_case(scene)
+    model, x_hat, y, ident, samples, info = fit_case(case, draws, seed, method)
+    at = quantities(model, x_hat)
+    derived = at.pop("_derived", None)
+    drawn = _drawn(model, samples)
+    estimates = {
+        p: _estimate(p, v, g, aff, ident, info["linear"], drawn.get(p), derived, case.unknowns)
+        for p, (v, g, aff) in at.items()
+    }
+    if not case.has_normal:
+        for path in (*DERIVED, *ENERGY_PARTS):
+            estimates[path] = Estimate(None, determined=False, why=NO_NORMAL)
+    residuals, worst = _residuals(case, model, y)
+    warnings = list(case.warnings)
+    flags = _flags(derived, estimates)
+    warnings += describe_flags(flags)
+    if derived is not None and derived["status"] != 0:
+        warnings.append(
+            f"e, mu and mu_c are not defined at the estimate: {describe_status(derived['status'])}"
+        )
+    dof = len(model.values) - ident.rank
+    if worst is not None and dof > 0:
+        warnings.append(
+            f"evidence[{worst['evidence']}] ({worst['label']}) disagrees most with the fit: z = {worst['z']:.3g}"
+            + (" (beyond 3 standard deviations)" if abs(worst["z"]) > 3 else "")
+        )
+    elif dof <= 0:
+        warnings.append("no redundant evidence: the fit reproduces every item, none checks another")
+    if ident.rank < len(case.unknowns) - (1 if case.moment else 0):
+        names = [p for p, e in estimates.items() if not e.determined and p in case.unknowns]
+        warnings.append(
+            f"the evidence does not determine {', '.join(names) or 'every unknown'} (see identifiability)"
+        )
+    return FitResult(
+        units=case.units,
+        names=case.names,
+        estimates=estimates,
+        unknowns=list(case.unknowns),
+        rank=ident.rank,
+        condition=ident.condition,
+        null_space=_null_space(case, ident),
+        residuals=residuals,
+        flags=flags,
+        info=info | {"draws": len(samples)},
+        warnings=warnings,
+    )
+
+
+def _drawn(model: Model, samples) -> dict:
+    """path -> array of the quantity over the Monte Carlo draws."""
+    if not samples:
+        return {}
+    rows = []
+    for x in samples:
+        q = quantities(model, x, gradients=False)
+        q.pop("_derived", None)
+        rows.append({p: v[0] for p, v in q.items()})
+    return {p: np.array([r[p] for r in rows], dtype=float) for p in rows[0]}
+
+
+def _estimate(
+    path, value, grad, affine, ident: Identifiability, linear, drawn, derived, unknowns
+) -> Estimate:
+    if not math.isfinite(value):
+        why = describe_status(derived["status"]) if derived is not None and derived["status"] else "undefined"
+        return Estimate(None, determined=False, why=f"not defined at the estimate: {why}")
+    if not ident.determined(grad):
+        return Estimate(None, determined=False, why=_why(ident, grad, unknowns))
+    if affine and linear:
+        sd = float(math.sqrt(max(grad @ ident.cov @ grad, 0.0)))
+        return Estimate(float(value), sd, (value - Z90 * sd, value + Z90 * sd))
+    if drawn is None or not np.isfinite(drawn).any():
+        sd = float(math.sqrt(max(grad @ ident.cov @ grad, 0.0)))
+        return Estimate(float(value), sd, (value - Z90 * sd, value + Z90 * sd))
+    ok = drawn[np.isfinite(drawn)]
+    return Estimate(
+        float(value), float(np.std(ok, ddof=1)), tuple(float(v) for v in np.percentile(ok, [5, 95]))
+    )
+
+
+def _why(ident: Identifiability, grad, unknowns) -> str:
+    """The null direction the quantity changes along, in words."""
+    if grad is None or not np.all(np.isfinite(grad)):
+        return "its derivative is undefined at the estimate"
+    g = (ident.N.T @ grad) / ident.scale
+    along = np.abs(ident.null_u.T @ g)
+    vec = ident.null_x()[:, int(np.argmax(along))]
+    terms = " ".join(f"{c:+.3g}·{name}" for c, name in zip(vec, unknowns) if abs(c) > 1e-6)
+    return f"changes along the direction ({terms}) of the unknowns, which no evidence reaches"
+
+
+def _null_space(case: FitCase, ident: Identifiability) -> list[dict]:
+    vecs = ident.null_x()
+    return [
+        {name: round(float(c), 6) for name, c in zip(case.unknowns, vecs[:, j]) if abs(c) > 1e-9}
+        for j in range(vecs.shape[1] if vecs.size else 0)
+    ]
+
+
+def _residuals(case: FitCase, model: Model, y):
+    r = model.residuals(y)
+    out, worst = [], None
+    for k, obs in enumerate(case.observations):
+        scale = math.degrees(1.0) if obs.angle else 1.0
+        fitted = y[k] if not obs.angle else obs.value + r[k] * obs.sd
+        row = {
+            "evidence": obs.evidence,
+            "label": obs.label,
+            "value": json_number(obs.value * scale),
+            "fitted": json_number(float(fitted) * scale),
+            "z": json_number(float(r[k])),
+        }
+        out.append(row)
+        if worst is None or abs(r[k]) > abs(worst["z"]):
+            worst = row | {"z": float(r[k])}
+    return out, worst
+
+
+def _flags(derived, estimates) -> int:
+    """Admissibility flag bits whose quantities the evidence determines."""
+    if derived is None or derived["status"] != 0:
+        return 0
+    flags = 0
+    for bit, needs in FLAG_NEEDS.items():
+        if derived["flags"] & bit and all(estimates[p].determined for p in needs):
+            flags |= bit
+    return flags
+
+
+__all__ = ["FitResult", "STATE", "fit"]
