@@ -28,6 +28,7 @@ from ._version import __version__
 from .codes import describe_status
 from .compare import compare
 from .crash3 import crash3
+from .evidence import cli as evidence_cli
 from .inverse import invert
 from .plot import add_plot_argument, save_plot
 from .reconstruct import reconstruct
@@ -566,6 +567,8 @@ COMMANDS: dict[str, Command] = {
         _run_validate,
     ),
 }
+
+COMMANDS.update({name: Command(*spec) for name, spec in evidence_cli.COMMANDS.items()})
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -153,7 +153,7 @@ def read_case(source: Mapping | str | Path) -> FitCase:
         raise SceneError(f"must be a non-empty list of evidence items, got {show_value(raw)}", "evidence")
     observations = []
     for k, item in enumerate(raw):
-        observations += read_item(item, k, units, names, fixed, source)
+        observations += read_item(item, k, units, names, fixed, source, warnings)
     yaw_observed = {o.how[1] for o in observations if o.how[0] == "state"}
     for i in range(2):
         if f"w{i + 1}" in yaw_observed and f"vehicles[{i}].yaw_rate" not in values and not fixed[i]:
@@ -234,7 +234,7 @@ def _state_map(states, fixed, values):
     return params, z0, columns, unknowns
 
 
-def _vehicle_index(raw: Any, names, path: str) -> int:
+def vehicle_index(raw: Any, names, path: str) -> int:
     if isinstance(raw, bool) or raw is None:
         raise SceneError(f"must be 0, 1 or a vehicle's name, got {show_value(raw)}", path)
     if isinstance(raw, int) and raw in (0, 1):
@@ -273,7 +273,7 @@ def _energy(value: Any, path: str, units: str, domain: str) -> float:
     return number
 
 
-def _sds(raw: Any, path: str, dimension: str, units: str, count: int) -> list[float]:
+def sds(raw: Any, path: str, dimension: str, units: str, count: int) -> list[float]:
     if raw is None:
         raise SceneError("missing (every evidence item needs its standard deviation)", path)
     if count == 2 and isinstance(raw, list):
@@ -283,8 +283,8 @@ def _sds(raw: Any, path: str, dimension: str, units: str, count: int) -> list[fl
     return [_scalar(raw, path, dimension, units, "positive")] * count
 
 
-def read_item(item: Any, k: int, units: str, names, fixed, source=None) -> list[Observation]:
-    """The scalar observations of evidence item `k`."""
+def read_item(item: Any, k: int, units: str, names, fixed, source=None, warnings=None) -> list[Observation]:
+    """The scalar observations of evidence item `k` (an EDR file's warnings go to `warnings`)."""
     path = f"evidence[{k}]"
     if not isinstance(item, Mapping):
         raise SceneError(f"must be an object, got {show_value(item)}", path)
@@ -292,7 +292,9 @@ def read_item(item: Any, k: int, units: str, names, fixed, source=None) -> list[
     if "edr" in item:
         from .edr_item import edr_observations
 
-        return edr_observations(item, k, units, names, fixed, source)
+        return edr_observations(
+            item, k, units, names, fixed, source, warnings if warnings is not None else []
+        )
     quantity = item.get("quantity")
     if quantity not in QUANTITIES:
         raise SceneError(
@@ -301,15 +303,16 @@ def read_item(item: Any, k: int, units: str, names, fixed, source=None) -> list[
     dimension, per_vehicle = QUANTITIES[quantity]
     if quantity == "rest":
         raise SceneError(
-            "a rest pose as evidence needs the run-out, which this build does not have yet", f"{path}.quantity"
+            "a rest pose as evidence needs the run-out, which this build does not have yet",
+            f"{path}.quantity",
         )
-    i = _vehicle_index(item.get("vehicle"), names, f"{path}.vehicle") if per_vehicle else None
+    i = vehicle_index(item.get("vehicle"), names, f"{path}.vehicle") if per_vehicle else None
     if per_vehicle and fixed[i]:
         raise SceneError("vehicle is fixed: it has no motion to observe", f"{path}.vehicle")
     if "value" not in item:
         raise SceneError("missing", f"{path}.value")
     n = None if i is None else i + 1
-    module = _module(item, path, units) if quantity.startswith("delta_v_") else (0.0, 0.0)
+    module = module_at(item, path, units) if quantity.startswith("delta_v_") else (0.0, 0.0)
     if "at" in item and not quantity.startswith("delta_v_"):
         raise SceneError("only delta_v_longitudinal and delta_v_lateral are read at a module", f"{path}.at")
     if quantity == "final_velocity":
@@ -317,15 +320,19 @@ def read_item(item: Any, k: int, units: str, names, fixed, source=None) -> list[
         if not isinstance(value, list) or len(value) != 2:
             raise SceneError(f"must be [x, y], got {show_value(value)}", f"{path}.value")
         vals = [_scalar(x, f"{path}.value[{j}]", dimension, units) for j, x in enumerate(value)]
-        sds = _sds(item.get("sd"), f"{path}.sd", dimension, units, 2)
+        deviations = sds(item.get("sd"), f"{path}.sd", dimension, units, 2)
         return [
             Observation(
-                k, f"vehicles[{i}].final_velocity[{j}]", vals[j], sds[j], ("linear", f"V{n}{c}", (0.0, 0.0))
+                k,
+                f"vehicles[{i}].final_velocity[{j}]",
+                vals[j],
+                deviations[j],
+                ("linear", f"V{n}{c}", (0.0, 0.0)),
             )
             for j, c in enumerate("xy")
         ]
     value = _scalar(item["value"], f"{path}.value", dimension, units)
-    (sd,) = _sds(item.get("sd"), f"{path}.sd", dimension, units, 1)
+    (sd,) = sds(item.get("sd"), f"{path}.sd", dimension, units, 1)
     if dimension == "angle":
         value, sd = math.radians(value), math.radians(sd)
     how = {
@@ -352,7 +359,7 @@ def read_item(item: Any, k: int, units: str, names, fixed, source=None) -> list[
     return [Observation(k, label, value, sd, how, angle=dimension == "angle")]
 
 
-def _module(item: Mapping, path: str, units: str) -> tuple[float, float]:
+def module_at(item: Mapping, path: str, units: str) -> tuple[float, float]:
     """The module position (forward, left) from the centre of gravity: ``at`` (or ``module``)."""
     raw = item.get("at", item.get("module"))
     if raw is None:

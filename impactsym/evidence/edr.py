@@ -62,11 +62,11 @@ class Pulse:
         return {
             "units": units,
             "delta_v": {
-                "longitudinal": lon,
-                "lateral": lat,
+                "longitudinal": float(lon),
+                "lateral": float(lat),
                 "magnitude": math.hypot(lon, lat),
                 "direction": math.degrees(math.atan2(lat, lon)),
-                "time_of_max": self.time[self.peak] * 1000.0,
+                "time_of_max": float(self.time[self.peak] * 1000.0),
             },
             "lateral_positive": "left",
             "ended": self.ended,
@@ -126,16 +126,27 @@ def _read_columns(path: Path) -> tuple[dict, dict]:
             try:
                 number = float(cell)
             except ValueError:
-                raise SceneError(f"line {line}: {name} = {cell.strip()!r} is not a number", str(path)) from None
+                raise SceneError(
+                    f"line {line}: {name} = {cell.strip()!r} is not a number", str(path)
+                ) from None
             if not math.isfinite(number):
                 raise SceneError(f"line {line}: {name} is not finite", str(path))
             values[name].append(number)
     return {k: np.array(v) for k, v in values.items()}, units
 
 
-def read_edr(path: str | Path, lateral_positive: str = "right") -> Pulse | PreCrash:
-    """Read a crash-pulse or pre-crash CSV (see the module docstring)."""
+def read_edr(
+    path: str | Path, lateral_positive: str = "right", integration: str = "trapezoid"
+) -> Pulse | PreCrash:
+    """Read a crash-pulse or pre-crash CSV (see the module docstring).
+
+    `integration` of an acceleration pulse: ``"trapezoid"`` (between samples) or
+    ``"sum"`` (each sample times the interval, up to and including it: how a
+    restraint module accumulates its own delta-V; it reproduces the CF09009B
+    report's cumulative figures more closely, see tests/test_edr.py)."""
     path = Path(path)
+    if integration not in INTEGRATIONS:
+        raise SceneError(f"must be one of {', '.join(INTEGRATIONS)}, got {integration!r}", "integration")
     if lateral_positive not in ("right", "left"):
         raise SceneError(f'must be "right" or "left", got {lateral_positive!r}', "lateral_positive")
     values, units = _read_columns(path)
@@ -158,7 +169,7 @@ def read_edr(path: str | Path, lateral_positive: str = "right") -> Pulse | PreCr
     if lateral_positive == "right":
         lat = -lat
     if kind == "acceleration":
-        lon, lat = _trapezoid(time, lon), _trapezoid(time, lat)
+        lon, lat = INTEGRATIONS[integration](time, lon), INTEGRATIONS[integration](time, lat)
     return _pulse(time, lon, lat, str(path))
 
 
@@ -166,6 +177,16 @@ def _trapezoid(time: np.ndarray, accel: np.ndarray) -> np.ndarray:
     """Cumulative delta-V from zero at the first sample, by the trapezoid rule."""
     steps = np.diff(time) * (accel[1:] + accel[:-1]) / 2.0
     return np.concatenate([[0.0], np.cumsum(steps)])
+
+
+def _sum(time: np.ndarray, accel: np.ndarray) -> np.ndarray:
+    """Cumulative delta-V as the running sum of each sample times its interval
+    (the first interval taken equal to the second)."""
+    steps = np.diff(time, prepend=2 * time[0] - time[1]) if len(time) > 1 else np.zeros(1)
+    return np.cumsum(steps * accel)
+
+
+INTEGRATIONS = {"trapezoid": _trapezoid, "sum": _sum}
 
 
 def _pulse(time, lon, lat, source) -> Pulse:
@@ -176,7 +197,9 @@ def _pulse(time, lon, lat, source) -> Pulse:
     warnings = []
     if earlier.size == 0:
         ended = False
-        warnings.append(f"the record ({(time[-1] - time[0]) * 1000:g} ms) is shorter than the 20 ms end-of-event window")
+        warnings.append(
+            f"the record ({(time[-1] - time[0]) * 1000:g} ms) is shorter than the 20 ms end-of-event window"
+        )
     else:
         i = earlier[-1]
         change = math.hypot(lon[-1] - lon[i], lat[-1] - lat[i])
