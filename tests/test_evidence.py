@@ -56,7 +56,9 @@ def test_six_final_velocities_reproduce_reconstruct(seed):
     want = reconstruct(reconstruct_scene(t))
     for i in range(2):
         assert got["vehicles"][i]["speed"] == pytest.approx(want.vehicles[i].speed, rel=1e-9)
-        assert got["vehicles"][i]["velocity"] == pytest.approx(list(want.vehicles[i].velocity), rel=1e-9, abs=1e-9)
+        assert got["vehicles"][i]["velocity"] == pytest.approx(
+            list(want.vehicles[i].velocity), rel=1e-9, abs=1e-9
+        )
     assert got["restitution"] == pytest.approx(want.e, rel=1e-8)
     assert got["impulse_ratio"] == pytest.approx(want.mu, rel=1e-8)
     assert got["critical_impulse_ratio"] == pytest.approx(want.mu_c, rel=1e-8)
@@ -99,7 +101,9 @@ def test_without_the_normal_e_and_mu_are_not_determined_but_the_speeds_are():
 def test_a_speed_no_evidence_reaches_is_reported_not_determined():
     """Car 1's EDR (speed, delta-V both ways) says nothing of car 2's speed."""
     t = truth(7)
-    got = fit(with_evidence(t, [("speed", 0), ("delta_v_longitudinal", 0), ("delta_v_lateral", 0)])).to_json_dict()
+    got = fit(
+        with_evidence(t, [("speed", 0), ("delta_v_longitudinal", 0), ("delta_v_lateral", 0)])
+    ).to_json_dict()
     ident = got["identifiability"]
     assert ident["rank"] == 3 and len(ident["unknowns"]) == 4
     assert got["vehicles"][1]["speed"] is None and got["vehicles"][1]["speed_interval"] is None
@@ -183,7 +187,13 @@ def test_module_delta_v_uses_the_yaw_change():
 
 def test_energy_loss_and_final_speed_evidence():
     t = truth(14)
-    items = [("speed", 0), ("final_speed", 0), ("final_direction", 0), ("final_speed", 1), ("energy_loss", None)]
+    items = [
+        ("speed", 0),
+        ("final_speed", 0),
+        ("final_direction", 0),
+        ("final_speed", 1),
+        ("energy_loss", None),
+    ]
     scene = with_evidence(t, items)
     scene["evidence"][-1]["sd"] = 2000.0
     del scene["evidence"][-1]["vehicle"]
@@ -231,7 +241,9 @@ def _coverage(items, trials, draws, sd_scale=1.0):
     hits = np.zeros(2)
     for k in range(trials):
         t = truth(1000 + k)
-        got = fit(with_evidence(t, items, np.random.default_rng(k), sd_scale), draws=draws, seed=k).to_json_dict()
+        got = fit(
+            with_evidence(t, items, np.random.default_rng(k), sd_scale), draws=draws, seed=k
+        ).to_json_dict()
         for i in range(2):
             low, high = got["vehicles"][i]["speed_interval"]
             hits[i] += low <= t["speeds"][i] <= high
