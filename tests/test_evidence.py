@@ -39,6 +39,10 @@ def with_evidence(t, items, noise=None, sd_scale=1.0):
     return scene
 
 
+def _why(result, path):
+    return next(w["reason"] for w in result["identifiability"]["why"] if w["quantity"] == path)
+
+
 def reconstruct_scene(t):
     scene = base_scene(t)
     del scene["evidence"]
@@ -94,7 +98,7 @@ def test_without_the_normal_e_and_mu_are_not_determined_but_the_speeds_are():
     assert got["vehicles"][1]["speed"] == pytest.approx(t["speeds"][1], rel=1e-7)
     for path in ("restitution", "impulse_ratio", "critical_impulse_ratio", "impulse.normal"):
         assert path in got["identifiability"]["not_determined"]
-        assert "normal_angle" in got["identifiability"]["why"][path]
+        assert "normal_angle" in _why(got, path)
     assert got["restitution"] is None and got["impulse_ratio"] is None
 
 
@@ -108,8 +112,8 @@ def test_a_speed_no_evidence_reaches_is_reported_not_determined():
     assert ident["rank"] == 3 and len(ident["unknowns"]) == 4
     assert got["vehicles"][1]["speed"] is None and got["vehicles"][1]["speed_interval"] is None
     assert "vehicles[1].speed" in ident["not_determined"]
-    assert "vehicles[1].speed" in ident["why"]["vehicles[1].speed"]
-    assert ident["null_space"] == [{"vehicles[1].speed": 1.0}]
+    assert "vehicles[1].speed" in _why(got, "vehicles[1].speed")
+    assert ident["null_space"] == [[0.0, 1.0, 0.0, 0.0]]
     # what it does determine: car 1's speed and the impulse, with intervals
     assert "vehicles[0].speed" in ident["determined"] and "impulse.x" in ident["determined"]
     assert got["vehicles"][0]["speed"] == pytest.approx(t["speeds"][0], rel=1e-9)

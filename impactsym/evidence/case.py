@@ -226,7 +226,11 @@ def _state_map(states, fixed, values):
             z0[3 * i], z0[3 * i + 1] = (float(c) for c in state["v"])
         else:
             column = np.zeros(9)
-            column[3 * i], column[3 * i + 1] = math.cos(params[f"theta{n}"]), math.sin(params[f"theta{n}"])
+            # exact 0 for a heading along an axis (cos 90° is 6e-17 in floating point)
+            column[3 * i], column[3 * i + 1] = (
+                0.0 if abs(c) < 1e-15 else c
+                for c in (math.cos(params[f"theta{n}"]), math.sin(params[f"theta{n}"]))
+            )
             columns.append(column)
             unknowns.append(f"vehicles[{i}].speed")
     columns += [_unit(6), _unit(7)]

@@ -161,18 +161,21 @@ class FitResult:
                 "condition": json_number(self.condition),
                 "determined": [p for p, e in self.estimates.items() if e.determined],
                 "not_determined": [p for p, e in self.estimates.items() if not e.determined],
-                "why": {p: e.why for p, e in self.estimates.items() if not e.determined},
+                "why": [
+                    {"quantity": p, "reason": e.why} for p, e in self.estimates.items() if not e.determined
+                ],
                 "null_space": self.null_space,
             },
-            "estimates": {
-                p: {
+            "estimates": [
+                {
+                    "quantity": p,
                     "value": self.value(p),
                     "sd": json_number(e.sd) if e.determined and e.sd is not None else None,
                     "interval": [json_number(v) for v in e.interval] if e.determined and e.interval else None,
                     "determined": e.determined,
                 }
                 for p, e in self.estimates.items()
-            },
+            ],
             "residuals": self.residuals,
             "admissibility": {
                 "checked_as": "flags",
@@ -286,12 +289,10 @@ def _why(ident: Identifiability, grad, unknowns) -> str:
     return f"changes along the direction ({terms}) of the unknowns, which no evidence reaches"
 
 
-def _null_space(case: FitCase, ident: Identifiability) -> list[dict]:
+def _null_space(case: FitCase, ident: Identifiability) -> list[list[float]]:
+    """The null directions, components in the order of `unknowns`, largest 1."""
     vecs = ident.null_x()
-    return [
-        {name: round(float(c), 6) for name, c in zip(case.unknowns, vecs[:, j]) if abs(c) > 1e-9}
-        for j in range(vecs.shape[1] if vecs.size else 0)
-    ]
+    return [[round(float(c), 6) + 0.0 for c in vecs[:, j]] for j in range(vecs.shape[1] if vecs.size else 0)]
 
 
 def _residuals(case: FitCase, model: Model, y):

@@ -32,7 +32,7 @@ def table(result) -> str:
     for r in result.residuals:
         lines.append(
             f"{r['evidence']:<10}{r['label']:<38}{table_cell(r['value']):>14}{table_cell(r['fitted']):>14}"
-            f"{table_cell(r['z']):>9}"
+            f"{_z(r['z']):>9}"
         )
     lines += (
         ["", "warnings:"] + [f"  - {w}" for w in result.warnings]
@@ -40,6 +40,10 @@ def table(result) -> str:
         else ["", "warnings: none"]
     )
     return "\n".join(lines)
+
+
+def _z(z) -> str:
+    return "-" if z is None else f"{0.0 if abs(z) < 5e-7 else z:.3g}"
 
 
 def _label(path: str, names) -> str:
