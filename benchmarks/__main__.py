@@ -19,6 +19,7 @@ os.environ["IMPACTSYM_BACKGROUND_COMPILE"] = "0"
 SUBCOMMANDS = {
     "accuracy": "benchmarks.accuracy",
     "body": "benchmarks.body",
+    "evidence": "benchmarks.evidence",
     "inverse": "benchmarks.inverse",
     "performance": "benchmarks.performance",
     "uncertainty": "benchmarks.uncertainty",
