@@ -155,3 +155,22 @@ def test_cli_edr_json():
         capture_output=True, text=True, env=env, timeout=120,
     )  # fmt: skip
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1
+
+
+def test_a_pulse_still_running_is_a_one_sided_bound():
+    """CF09009B's pulse has not ended: its delta-V is a lower bound. Evidence of a
+    larger delta-V (here the magnitude, 12 m/s against the recorded ~9.7 m/s at the
+    module) is then fitted without disagreement; evidence of a smaller one is not."""
+    base = json.loads((Path(__file__).parents[1] / "examples" / "fit_cf09009b_edr_si.json").read_text())
+    base["evidence"][0]["edr"] = str(PULSE)
+    larger = json.loads(json.dumps(base))
+    larger["evidence"].append({"vehicle": 0, "quantity": "delta_v", "value": 12.0, "sd": 0.3})
+    got = fit(larger, draws=0).to_json_dict()
+    assert got["vehicles"][0]["delta_v_magnitude"] == pytest.approx(12.0, rel=1e-6)
+    assert max(abs(r["z"]) for r in got["residuals"]) < 1e-6
+    assert any("one-sided" in w for w in got["warnings"])
+    smaller = json.loads(json.dumps(base))
+    smaller["evidence"].append({"vehicle": 0, "quantity": "delta_v", "value": 7.0, "sd": 0.3})
+    got = fit(smaller, draws=0).to_json_dict()
+    z = {r["label"]: r["z"] for r in got["residuals"]}
+    assert z["vehicles[0].delta_v_longitudinal"] > 1.0  # the bound holds the fit back

@@ -67,7 +67,8 @@ ENERGY_UNIT = {"SI": "J", "US": "ft*lbf"}
 class Observation:
     """One scalar observation: evidence item `evidence`, its `label`, the
     value and sd in scene units (angles in radians), and how the model
-    computes it: ``("linear", output, (a, b))`` (an output of evidence_linear
+    computes it (`one_sided` ±1: the truth is at least `value` in that
+    sense, a delta-V recorded before its pulse ended): ``("linear", output, (a, b))`` (an output of evidence_linear
     with that vehicle's module at (a, b)), ``("state", name)``,
     ``("norm" | "direction", (x_output, y_output))``, ``("energy",)``."""
 
@@ -77,6 +78,7 @@ class Observation:
     sd: float
     how: tuple
     angle: bool = False
+    one_sided: int = 0  # +1/-1: the truth is at least `value` in this sense (a pulse still running)
 
 
 @dataclass

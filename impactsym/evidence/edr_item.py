@@ -10,6 +10,7 @@ the scene file's folder.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from ..errors import SceneError, show_value
@@ -51,19 +52,17 @@ def edr_observations(item, k: int, units: str, names, fixed, source, warnings: l
     sd_lon, sd_lat = sds(item.get("sd"), f"{path}.sd", "speed", units, 2)
     warnings += [f"{path} ({file.name}): {w}" for w in record.warnings]
     peak = record.peak
+    values = (record.longitudinal[peak] * scale, record.lateral[peak] * scale)
+    # A pulse still running at the end of the record understates the delta-V:
+    # each component is then a bound (the truth at least as far from 0), one-sided.
+    sides = (0, 0) if record.ended else tuple(int(math.copysign(1, v)) for v in values)
+    if not record.ended:
+        warnings.append(f"{path}: the recorded delta-V is used as a one-sided bound (at least this large)")
     return [
         Observation(
-            k,
-            f"vehicles[{i}].delta_v_longitudinal",
-            record.longitudinal[peak] * scale,
-            sd_lon,
-            ("linear", f"dl{n}", module),
-        ),
-        Observation(
-            k,
-            f"vehicles[{i}].delta_v_lateral",
-            record.lateral[peak] * scale,
-            sd_lat,
-            ("linear", f"dt{n}", module),
-        ),
+            k, f"vehicles[{i}].delta_v_{part}", value, sd, ("linear", f"{out}{n}", module), one_sided=side
+        )
+        for part, out, value, sd, side in zip(
+            ("longitudinal", "lateral"), ("dl", "dt"), values, (sd_lon, sd_lat), sides
+        )
     ]

@@ -219,13 +219,13 @@ def fit(scene: Mapping | str | Path, draws: int = 400, seed: int = 0, method: st
             f"e, mu and mu_c are not defined at the estimate: {describe_status(derived['status'])}"
         )
     dof = len(model.values) - ident.rank
-    if worst is not None and dof > 0:
+    if worst is not None and dof > 0 and abs(worst["z"]) > 1e-6:
         warnings.append(
             f"evidence[{worst['evidence']}] ({worst['label']}) disagrees most with the fit: z = {worst['z']:.3g}"
             + (" (beyond 3 standard deviations)" if abs(worst["z"]) > 3 else "")
         )
-    elif dof <= 0:
-        warnings.append("no redundant evidence: the fit reproduces every item, none checks another")
+    elif worst is not None:
+        warnings.append("the fit reproduces every item: no evidence checks another")
     if ident.rank < len(case.unknowns) - (1 if case.moment else 0):
         names = [p for p, e in estimates.items() if not e.determined and p in case.unknowns]
         warnings.append(

@@ -43,7 +43,10 @@ class Model:
                 a, b = math.nan, None
             offsets.append(a)
             rows.append(b)
-        self.linear = np.array([b is not None for b in rows])
+        self.one_sided = np.array([o.one_sided for o in case.observations], dtype=float)
+        # a one-sided observation is affine but its residual is not: it is no part of a closed form
+        self.linear = np.array([b is not None for b in rows]) & (self.one_sided == 0)
+        self.affine_rows = np.array([b is not None for b in rows])
         self.values = np.array([o.value for o in case.observations])
         self.sd = np.array([o.sd for o in case.observations])
         self.angle = np.array([o.angle for o in case.observations])
@@ -100,10 +103,22 @@ class Model:
         return y, J
 
     def residuals(self, y) -> np.ndarray:
-        """(y - value)/sd, angles wrapped to (-pi, pi]."""
+        """(y - value)/sd, angles wrapped to (-pi, pi], 0 for a one-sided
+        observation whose prediction lies beyond its value in its sense."""
         diff = y - self.values
         diff = np.where(self.angle, (diff + math.pi) % (2 * math.pi) - math.pi, diff)
+        diff = np.where(self._beyond(y), 0.0, diff)
         return diff / self.sd
+
+    def _beyond(self, y) -> np.ndarray:
+        """One-sided observations predicted beyond their value (by more than
+        1e-9 sd: at the bound itself the observation still holds the fit)."""
+        return self.one_sided * (y - self.values) > 1e-9 * self.sd
+
+    def whitened(self, y, J):
+        """(r, dr/dx): residuals and their Jacobian (rows of inactive one-sided observations 0)."""
+        r = self.residuals(y)
+        return r, np.where(self._beyond(y)[:, None], 0.0, J / self.sd[:, None])
 
     def derived(self, x, jacobian: bool = True) -> dict:
         """The evidence_derived outputs at x (e, mu, mu_c, Pn, Pt, TL, ...),

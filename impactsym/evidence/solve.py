@@ -69,28 +69,24 @@ def gauss_newton(model: Model, xp, N, u0, values=None, max_iter=60):
         model.values = values
     try:
         u = np.array(u0, dtype=float)
-        y, J = model.predict(xp + N @ u)
-        r = model.residuals(y)
+        r, Jw = model.whitened(*model.predict(xp + N @ u))
         cost = r @ r
         for iteration in range(1, max_iter + 1):
-            step = _scaled_pinv_step((J / model.sd[:, None]) @ N, r)
+            step = _scaled_pinv_step(Jw @ N, r)
             t = 1.0
             while True:
                 trial = u + t * step
                 try:
-                    y2, J2 = model.predict(xp + N @ trial)
-                    r2 = model.residuals(y2)
+                    r2, Jw2 = model.whitened(*model.predict(xp + N @ trial))
                     cost2 = r2 @ r2
                 except SceneError:
                     cost2 = math.inf
-                if cost2 <= cost * (1 + 1e-12) or t < 1e-6:
+                if cost2 <= cost * (1 + 1e-12):
                     break
+                if t < 1e-6:  # no step along this direction lowers the sum of squares
+                    return u, iteration
                 t /= 2
-            if not math.isfinite(cost2):
-                raise SceneError(
-                    "the fit reached a state where an observation is undefined (a zero velocity)"
-                )
-            u, J, r, old, cost = trial, J2, r2, cost, cost2
+            u, Jw, r, old, cost = trial, Jw2, r2, cost, cost2
             if np.linalg.norm(t * step) <= 1e-12 * (1 + np.linalg.norm(u)) or abs(old - cost) <= 1e-15 * (
                 1 + old
             ):
@@ -114,7 +110,7 @@ def start(model: Model, xp, N) -> np.ndarray:
     case = model.case
     rows, rhs, sds = [], [], []
     for k, obs in enumerate(case.observations):
-        if model.linear[k]:
+        if model.affine_rows[k]:
             rows.append(model.B[k])
             rhs.append(model.values[k] - model.a[k])
             sds.append(obs.sd)
@@ -225,7 +221,7 @@ def fit_case(case: FitCase, draws: int = 400, seed: int = 0, method: str = "auto
         u_hat, iterations = linear_solve(model, xp, N), 0
     x_hat = xp + N @ u_hat
     y, J = model.predict(x_hat)
-    ident = Identifiability(J / model.sd[:, None], N)
+    ident = Identifiability(model.whitened(y, J)[1], N)
     samples = draw_fits(model, xp, N, u_hat, ident, linear, draws, seed) if draws else []
     info = {
         "linear": linear,
