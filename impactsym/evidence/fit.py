@@ -39,6 +39,7 @@ DERIVED = {
     "impulse_ratio": "mu",
     "critical_impulse_ratio": "mu_c",
 }
+UNBOUNDED = 1e3
 NO_NORMAL = (
     "needs impact.normal_angle: the impulse (Px, Py) does not say how it splits into normal and "
     "tangential parts"
@@ -124,7 +125,7 @@ class FitResult:
                     "name": name,
                     "speed": self.value(f"{p}.speed"),
                     "speed_sd": json_number(speed.sd) if speed.determined and speed.sd is not None else None,
-                    "speed_interval": [json_number(v) for v in speed.interval]
+                    "speed_interval": [_end(v) for v in speed.interval]
                     if speed.determined and speed.interval
                     else None,
                     "velocity": [self.value(f"{p}.velocity[{j}]") for j in range(2)],
@@ -171,7 +172,7 @@ class FitResult:
                     "quantity": p,
                     "value": self.value(p),
                     "sd": json_number(e.sd) if e.determined and e.sd is not None else None,
-                    "interval": [json_number(v) for v in e.interval] if e.determined and e.interval else None,
+                    "interval": [_end(v) for v in e.interval] if e.determined and e.interval else None,
                     "determined": e.determined,
                 }
                 for p, e in self.estimates.items()
@@ -211,9 +212,17 @@ def fit(scene: Mapping | str | Path, draws: int = 400, seed: int = 0, method: st
         for path in (*DERIVED, *ENERGY_PARTS):
             estimates[path] = Estimate(None, determined=False, why=NO_NORMAL)
     residuals, worst = _residuals(case, model, y)
+    unbounded = [p for p, e in estimates.items() if e.determined and e.interval and None in e.interval]
+    if unbounded:
+        warnings_unbounded = [
+            f"the 90 % interval of {', '.join(unbounded)} is unbounded on one side: the evidence lets it run "
+            "away (its end is null; e.g. a departure direction close to the heading allows any speed)"
+        ]
+    else:
+        warnings_unbounded = []
     warnings = list(case.warnings)
     flags = _flags(derived, estimates)
-    warnings += describe_flags(flags)
+    warnings += describe_flags(flags) + warnings_unbounded
     if derived is not None and derived["status"] != 0:
         warnings.append(
             f"e, mu and mu_c are not defined at the estimate: {describe_status(derived['status'])}"
@@ -246,6 +255,10 @@ def fit(scene: Mapping | str | Path, draws: int = 400, seed: int = 0, method: st
     )
 
 
+def _end(value):
+    return None if value is None else json_number(value)
+
+
 def _drawn(model: Model, samples) -> dict:
     """path -> array of the quantity over the Monte Carlo draws."""
     if not samples:
@@ -273,20 +286,27 @@ def _estimate(
         sd = float(math.sqrt(max(grad @ ident.cov @ grad, 0.0)))
         return Estimate(float(value), sd, (value - Z90 * sd, value + Z90 * sd))
     ok = drawn[np.isfinite(drawn)]
-    return Estimate(
-        float(value), float(np.std(ok, ddof=1)), tuple(float(v) for v in np.percentile(ok, [5, 95]))
-    )
+    low, high = (float(v) for v in np.percentile(ok, [5, 95]))
+    # A tail a thousand times wider than the estimate and its linearised sd is
+    # not an interval: the evidence lets the quantity run away (a departure
+    # direction along the heading allows any speed). That end is null.
+    reach = UNBOUNDED * (abs(value) + math.sqrt(max(grad @ ident.cov @ grad, 0.0)))
+    ends = (None if value - low > reach else low, None if high - value > reach else high)
+    sd = float(np.std(ok, ddof=1)) if None not in ends else None
+    return Estimate(float(value), sd, ends)
 
 
 def _why(ident: Identifiability, grad, unknowns) -> str:
-    """The null direction the quantity changes along, in words."""
+    """The null directions the quantity changes along, in words."""
     if grad is None or not np.all(np.isfinite(grad)):
         return "its derivative is undefined at the estimate"
-    g = (ident.N.T @ grad) / ident.scale
-    along = np.abs(ident.null_u.T @ g)
-    vec = ident.null_x()[:, int(np.argmax(along))]
-    terms = " ".join(f"{c:+.3g}·{name}" for c, name in zip(vec, unknowns) if abs(c) > 1e-6)
-    return f"changes along the direction ({terms}) of the unknowns, which no evidence reaches"
+    vecs = ident.null_x()
+    along = np.abs(grad @ vecs)
+    words = [
+        "(" + " ".join(f"{c:+.4g}·{name}" for c, name in zip(vecs[:, j], unknowns) if c != 0) + ")"
+        for j in np.nonzero(along > 1e-6 * along.max())[0]
+    ]
+    return f"changes along {' and '.join(words)} in the unknowns, which no evidence reaches"
 
 
 def _null_space(case: FitCase, ident: Identifiability) -> list[list[float]]:

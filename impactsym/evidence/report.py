@@ -8,22 +8,24 @@ from ..result import UNIT_LABELS, table_cell
 def table(result) -> str:
     """Estimates with 90 % intervals and a determined column, then the residuals."""
     labels = UNIT_LABELS[result.units]
+    width = max(38, *(len(_label(p, result.names)) + 2 for p in result.estimates))
     lines = [
         f"fit to evidence, {result.units} units (speeds {labels['velocity']}, energy {labels['energy']}, "
         f"yaw rates rad/s); method: {result.info['method']}",
         "",
-        f"{'quantity':<38}{'estimate':>14}{'90 % interval':>30}  determined",
+        f"{'quantity':<{width}}{'estimate':>14}{'90 % interval':>30}  determined",
     ]
     for path, est in result.estimates.items():
         if est.determined and est.interval is not None and est.sd == 0:
             continue  # known inputs (a yaw rate of 0 given), not estimates
         label = _label(path, result.names)
         if est.determined:
-            low, high = est.interval or (None, None)
-            span = f"[{table_cell(low)}, {table_cell(high)}]" if low is not None else ""
-            lines.append(f"{label:<38}{table_cell(est.value):>14}{span:>30}  yes")
+            low, high = est.interval or ("", "")
+            ends = ["unbounded" if v is None else table_cell(v) for v in (low, high)]
+            span = f"[{ends[0]}, {ends[1]}]" if est.interval else ""
+            lines.append(f"{label:<{width}}{table_cell(est.value):>14}{span:>30}  yes")
         else:
-            lines.append(f"{label:<38}{'-':>14}{'':>30}  no")
+            lines.append(f"{label:<{width}}{'-':>14}{'':>30}  no")
     lines += ["", f"rank {result.rank} of {len(result.unknowns)} unknowns ({', '.join(result.unknowns)})"]
     for path, est in result.estimates.items():
         if not est.determined and path in result.unknowns:

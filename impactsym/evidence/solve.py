@@ -143,6 +143,21 @@ def start(model: Model, xp, N) -> np.ndarray:
     return _scaled_pinv_step(A @ N, -b)
 
 
+def _from_start(model: Model, xp, N, u0):
+    """Gauss–Newton from u0, or, where an observation is undefined there (a
+    zero delta-V or final velocity has no magnitude derivative or direction),
+    from u0 moved by a fixed small offset of each unknown's scale."""
+    try:
+        return gauss_newton(model, xp, N, u0)
+    except SceneError:
+        scale = _speed_scale(model)
+        masses = [model.case.params[m] for m in ("m1", "m2") if math.isfinite(model.case.params[m])]
+        size = np.array([scale if n.endswith((".speed", ".yaw_rate")) else 0.1 * scale * min(masses)
+                         for n in model.case.unknowns])  # fmt: skip
+        offset = np.linalg.lstsq(N, size * np.cos(np.arange(len(size)) + 1.0), rcond=None)[0]
+        return gauss_newton(model, xp, N, u0 + offset)
+
+
 def _speed_scale(model: Model) -> float:
     speeds = [
         abs(o.value)
@@ -174,9 +189,29 @@ class Identifiability:
         self.cov = N @ cov_u @ N.T  # in x
 
     def null_x(self) -> np.ndarray:
-        """Null directions in x (columns), each scaled to unit largest component."""
+        """A basis of the null directions in x (columns) in reduced echelon
+        form over the unknowns in order: each direction has a 1 on an unknown
+        the others do not move (so a speed nothing reaches is a direction of
+        its own, apart from a rotation of the impulse)."""
         vecs = self.N @ (self.null_u / self.scale[:, None])
-        return vecs / np.max(np.abs(vecs), axis=0, keepdims=True) if vecs.size else vecs
+        if not vecs.size:
+            return vecs
+        rows = (vecs / np.linalg.norm(vecs, axis=0)).T.copy()
+        pivot_row = 0
+        for j in range(rows.shape[1]):
+            if pivot_row == rows.shape[0]:
+                break
+            r = pivot_row + int(np.argmax(np.abs(rows[pivot_row:, j])))
+            if abs(rows[r, j]) < 1e-8:
+                continue
+            rows[[pivot_row, r]] = rows[[r, pivot_row]]
+            rows[pivot_row] /= rows[pivot_row, j]
+            for other in range(rows.shape[0]):
+                if other != pivot_row:
+                    rows[other] -= rows[other, j] * rows[pivot_row]
+            pivot_row += 1
+        rows[np.abs(rows) < 1e-12 * np.max(np.abs(rows), axis=1, keepdims=True)] = 0.0
+        return rows.T
 
     def determined(self, grad) -> bool:
         """True when `grad` (in x) has no component along the null space."""
@@ -216,7 +251,7 @@ def fit_case(case: FitCase, draws: int = 400, seed: int = 0, method: str = "auto
     linear = bool(np.all(model.linear))
     if method == "gauss-newton" or not linear:
         u0 = start(model, xp, N) if not linear else np.zeros(N.shape[1])
-        u_hat, iterations = gauss_newton(model, xp, N, u0)
+        u_hat, iterations = _from_start(model, xp, N, u0)
     else:
         u_hat, iterations = linear_solve(model, xp, N), 0
     x_hat = xp + N @ u_hat
