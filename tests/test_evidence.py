@@ -276,3 +276,53 @@ def test_coverage_of_monte_carlo_intervals():
     hits = _coverage(MIXED + [("final_speed", 1)], trials, draws=200)
     low, high = _binomial_bounds(trials)
     assert all(low <= h <= high for h in hits), hits
+
+
+def test_observed_yaw_rate_becomes_an_unknown():
+    """A vehicle that gives no yaw_rate but whose pre-impact yaw rate is observed
+    gets it as an unknown; the truth's 0 comes back."""
+    t = truth(16)
+    scene = with_evidence(t, SIX)
+    scene["evidence"].append({"vehicle": 1, "quantity": "yaw_rate", "value": 0.0, "sd": 0.05})
+    got = fit(scene, draws=0).to_json_dict()
+    assert "vehicles[1].yaw_rate" in got["identifiability"]["unknowns"]
+    assert abs(got["vehicles"][1]["yaw_rate"]) < 1e-8
+    assert got["vehicles"][1]["speed"] == pytest.approx(t["speeds"][1], rel=1e-9)
+
+
+def test_barrier_crush_energy_is_the_energy_loss():
+    """Against a fixed barrier, one car's crush energy is the energy loss: with its
+    speed and a departure direction the fit recovers the reference solution."""
+    row = {"m1": 1500.0, "m2": math.inf, "I1": 2500.0, "I2": math.inf, "v1x": 15.0, "v1y": 0.0, "w1": 0.0,
+           "v2x": 0.0, "v2y": 0.0, "w2": 0.0, "r1x": 2.2, "r1y": 0.5, "r2x": -0.1, "r2y": 0.0,
+           "gamma": math.radians(10.0), "e": 0.1, "mu": 0.1, "e_m": 1.0}  # fmt: skip
+    from impactsym.testing.reference import solve_reference
+
+    ref = {k: float(v) for k, v in solve_reference(row).items()}
+    scene = {
+        "units": "SI",
+        "impact": {"normal_angle": 10.0},
+        "vehicles": [
+            {
+                "name": "car",
+                "mass": 1500.0,
+                "yaw_inertia": 2500.0,
+                "heading": 0.0,
+                "impact_point": [2.2, 0.5],
+            },
+            {"name": "barrier", "fixed": True, "impact_point": [-0.1, 0.0]},
+        ],
+        "evidence": [
+            {"vehicle": "car", "quantity": "crush_energy", "value": ref["TL"], "sd": 2000.0},
+            {"vehicle": "car", "quantity": "final_velocity", "value": [ref["V1x"], ref["V1y"]], "sd": 0.2},
+        ],
+    }
+    got = fit(scene, draws=50).to_json_dict()
+    assert got["identifiability"]["unknowns"] == ["vehicles[0].speed", "impulse.x", "impulse.y"]
+    assert got["vehicles"][0]["speed"] == pytest.approx(15.0, rel=1e-6)
+    assert got["restitution"] == pytest.approx(0.1, rel=1e-6)
+    assert got["impulse_ratio"] == pytest.approx(0.1, rel=1e-6)
+    two_moving = with_evidence(truth(1), LINEAR)
+    two_moving["evidence"].append({"vehicle": 0, "quantity": "crush_energy", "value": 1e5, "sd": 1e4})
+    with pytest.raises(SceneError, match="crush energy is the energy loss only against a fixed barrier"):
+        fit(two_moving, draws=0)

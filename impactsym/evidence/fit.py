@@ -335,8 +335,18 @@ def _residuals(case: FitCase, model: Model, y):
 
 
 def _flags(derived, estimates) -> int:
-    """Admissibility flag bits whose quantities the evidence determines."""
-    if derived is None or derived["status"] != 0:
+    """Admissibility flag bits whose quantities the evidence determines. Without
+    a normal (no evidence_derived) only the energy loss can be checked: T_L < 0,
+    beyond 1e-12 of its interval's width, is energy created (bit 1)."""
+    if derived is None:
+        total = estimates["energy_loss.total"]
+        if total.determined and total.value is not None:
+            width = (
+                max(abs(v) for v in total.interval if v is not None) if total.interval else abs(total.value)
+            )
+            return 1 if total.value < -1e-12 * width else 0
+        return 0
+    if derived["status"] != 0:
         return 0
     flags = 0
     for bit, needs in FLAG_NEEDS.items():
