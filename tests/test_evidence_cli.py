@@ -47,12 +47,12 @@ def test_fit_table_for_people():
     assert "90 % interval" in proc.stdout and "determined" in proc.stdout
 
 
-def test_residual_chart(tmp_path):
+def test_residual_chart_and_scene_picture(tmp_path):
     pytest.importorskip("matplotlib")
-    out = tmp_path / "res.png"
-    proc = run("fit", str(EXAMPLE), "--draws", "0", "--plot", str(out))
+    out, scene = tmp_path / "res.png", tmp_path / "scene.png"
+    proc = run("fit", str(EXAMPLE), "--draws", "0", "--plot", str(out), "--scene-plot", str(scene))
     assert proc.returncode == 0, proc.stderr
-    assert out.stat().st_size > 1000
+    assert out.stat().st_size > 1000 and scene.stat().st_size > 1000
 
 
 @pytest.mark.parametrize(

@@ -25,6 +25,11 @@ def add_fit_arguments(parser: argparse.ArgumentParser) -> None:
         help="auto: closed form on linear evidence; gauss-newton: always iterate",
     )  # fmt: skip
     parser.add_argument("--plot", metavar="OUT.png", help="draw the normalised residuals per evidence item")
+    parser.add_argument(
+        "--scene-plot",
+        metavar="OUT.png",
+        help="draw the scene with the fitted motion and the departure directions",
+    )
 
 
 def add_edr_arguments(parser: argparse.ArgumentParser) -> None:
@@ -55,6 +60,10 @@ def run_fit(args: argparse.Namespace) -> int:
         from .report import residual_chart
 
         residual_chart(result, args.plot)
+    if args.scene_plot:
+        from .report import scene_picture
+
+        scene_picture(result, args.scene, args.scene_plot)
     print(json.dumps(result.to_json_dict(), indent=2) if args.json else result.table())
     return 0
 

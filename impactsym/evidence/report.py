@@ -79,3 +79,75 @@ def residual_chart(result, out: str) -> None:
     fig.tight_layout()
     fig.savefig(out, dpi=120)
     plt.close(fig)
+
+
+def scene_picture(result, scene, out: str) -> None:
+    """The scene drawn with the fitted motion (impactsym.plot) and the departure
+    directions of the evidence as dashed rays from the centres of gravity. A
+    vehicle whose speed the evidence does not determine is drawn at rest and
+    said so in the title."""
+    import math
+    from types import SimpleNamespace
+
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from .. import plot
+    from .case import read_case
+
+    case = read_case(scene)
+    data = result.to_json_dict()
+    vehicles, drawn = [], []
+    for i, fitted in enumerate(data["vehicles"]):
+        n = i + 1
+        entry = {"name": fitted["name"], "impact_point": [case.params[f"r{n}x"], case.params[f"r{n}y"]]}
+        if case.fixed[i]:
+            entry["fixed"] = True
+        else:
+            known = None not in fitted["velocity"]
+            entry.update(
+                mass=case.params[f"m{n}"],
+                yaw_inertia=case.params[f"I{n}"],
+                heading=math.degrees(case.headings[i]),
+                velocity=fitted["velocity"] if known else [0.0, 0.0],
+                yaw_rate=fitted["yaw_rate"] or 0.0,
+            )
+            if not known:
+                drawn.append(fitted["name"])
+        vehicles.append(entry)
+    gamma = math.degrees(case.params["gamma"])
+    forward = {"units": case.units, "impact": {"normal_angle": gamma, "restitution": 0.0, "impulse_ratio": 0.0},
+               "vehicles": vehicles}  # fmt: skip
+    look = SimpleNamespace(
+        kind="solve",
+        units=case.units,
+        vehicles=[
+            SimpleNamespace(
+                velocity=v["final_velocity"] if None not in v["final_velocity"] else None,
+                yaw_rate=v["final_yaw_rate"],
+                delta_v=v["delta_v"] if None not in v["delta_v"] else None,
+            )
+            for v in data["vehicles"]
+        ],
+    )
+    fig = Figure(figsize=(9.0, 6.5), layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    title = "fitted motion" + (f" ({', '.join(drawn)}: speed not determined, drawn at rest)" if drawn else "")
+    plot.scene(forward, result=look, ax=ax, title=title)
+    span = max(abs(c) for c in (*ax.get_xlim(), *ax.get_ylim()))
+    for obs in case.observations:
+        if obs.how[0] != "direction":
+            continue
+        n = int(obs.how[1][0][1])
+        cg = (-case.params[f"r{n}x"], -case.params[f"r{n}y"])
+        for angle, style in (
+            (obs.value, "-"),
+            (obs.value - 1.645 * obs.sd, ":"),
+            (obs.value + 1.645 * obs.sd, ":"),
+        ):
+            end = (cg[0] + span * math.cos(angle), cg[1] + span * math.sin(angle))
+            ax.plot([cg[0], end[0]], [cg[1], end[1]], style, color="tab:olive", lw=1.0)
+    ax.text(0.01, 0.01, "olive: departure directions of the evidence (dotted: 90 % band)", color="tab:olive",
+            transform=ax.transAxes, fontsize=8, va="bottom")  # fmt: skip
+    fig.savefig(out, dpi=120, bbox_inches="tight")
