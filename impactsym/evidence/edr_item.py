@@ -14,8 +14,8 @@ import math
 from pathlib import Path
 
 from ..errors import SceneError, show_value
-from .case import Observation, module_at, sds, vehicle_index
 from .edr import PreCrash, read_edr
+from .items import Observation, module_at, sds, vehicle_index
 
 TO_SCENE = {"SI": 1.0, "US": 1.0 / 0.3048}  # m/s -> scene speed unit
 
