@@ -326,3 +326,37 @@ def test_barrier_crush_energy_is_the_energy_loss():
     two_moving["evidence"].append({"vehicle": 0, "quantity": "crush_energy", "value": 1e5, "sd": 1e4})
     with pytest.raises(SceneError, match="crush energy is the energy loss only against a fixed barrier"):
         fit(two_moving, draws=0)
+
+
+def test_an_uncertain_normal_angle_widens_e_and_mu_not_the_speeds():
+    """impact.normal_angle as a distribution: the Monte Carlo draws it, so the
+    Γ-dependent quantities carry its spread while the speeds do not move."""
+    t = truth(17)
+    fixed = with_evidence(t, LINEAR)
+    spread = copy.deepcopy(fixed)
+    gamma = spread["impact"]["normal_angle"]
+    spread["impact"]["normal_angle"] = {"uniform": [gamma - 6.0, gamma + 6.0]}
+    a, b = fit(fixed, draws=300).to_json_dict(), fit(spread, draws=300).to_json_dict()
+    assert b["vehicles"][1]["speed_interval"] == pytest.approx(a["vehicles"][1]["speed_interval"], rel=1e-12)
+    assert b["restitution"] == pytest.approx(a["restitution"], rel=1e-12)  # the nominal angle
+
+    def widths(result):
+        return {
+            r["quantity"]: r["interval"][1] - r["interval"][0]
+            for r in result["estimates"]
+            if r["quantity"] in ("impulse_ratio", "critical_impulse_ratio")
+        }
+
+    width, wider = widths(a), widths(b)
+    assert all(wider[k] > 1.5 * width[k] for k in width), (width, wider)
+    angle = next(r for r in b["estimates"] if r["quantity"] == "impact.normal_angle")
+    assert angle["interval"] == pytest.approx([gamma - 5.4, gamma + 5.4], abs=0.2)  # 5 % and 95 % of ±6
+
+
+def test_without_a_normal_angle_it_is_reported_not_determined():
+    t = truth(18)
+    scene = with_evidence(t, LINEAR)
+    del scene["impact"]
+    got = fit(scene, draws=0).to_json_dict()
+    assert "impact.normal_angle" in got["identifiability"]["not_determined"]
+    assert "crush-surface angle" in _why(got, "impact.normal_angle")

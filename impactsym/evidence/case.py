@@ -65,6 +65,7 @@ class FitCase:
     fixed: tuple[bool, bool]
     headings: tuple[float, float]
     warnings: list[str] = field(default_factory=list)
+    normal: tuple | None = None  # the normal angle's distribution: (kind, params [deg], offset [deg])
 
 
 def read_case(source: Mapping | str | Path) -> FitCase:
@@ -99,14 +100,23 @@ def read_case(source: Mapping | str | Path) -> FitCase:
     if "moment_restitution" in impact:
         leaves.number(impact["moment_restitution"], "impact.moment_restitution", "number")
     values = {path: leaf.nominal for path, leaf in leaves.leaves.items()}
-    if any(leaf.kind is not None for leaf in leaves.leaves.values()):
-        raise SceneError("fit takes plain numbers for the vehicles and impact (evidence carries the sd)")
+    for path, leaf in leaves.leaves.items():
+        if leaf.kind is not None and path != "impact.normal_angle":
+            raise SceneError(
+                "fit takes plain numbers here (the evidence carries the sd; only impact.normal_angle "
+                "may be a distribution)",
+                path,
+            )
     states = [vehicle_state(values, i, units) for i in range(2)]
     params, z0, columns, unknowns = _state_map(states, fixed, values)
     has_normal = "impact.normal_angle" in values
+    normal = None  # (kind, params [deg], offset [deg]) of a normal angle given as a distribution
     if has_normal:
         angle, flipped = used_normal_angle(values["impact.normal_angle"], states[0]["r"], states[1]["r"])
         params["gamma"] = math.radians(float(angle))
+        leaf = leaves.leaves["impact.normal_angle"]
+        if leaf.kind is not None:
+            normal = (leaf.kind, leaf.params, float(angle) - values["impact.normal_angle"])
         if flipped:
             warnings.append(f"impact.normal_angle is turned round to {float(angle):g} deg (n·(r1 - r2) > 0)")
     else:
@@ -135,7 +145,19 @@ def read_case(source: Mapping | str | Path) -> FitCase:
     T = np.array(columns, dtype=float).T if columns else np.zeros((9, 0))
     headings = tuple(math.radians(s["heading"] or 0.0) for s in states)
     return FitCase(
-        units, names, params, z0, T, unknowns, observations, has_normal, moment, fixed, headings, warnings
+        units,
+        names,
+        params,
+        z0,
+        T,
+        unknowns,
+        observations,
+        has_normal,
+        moment,
+        fixed,
+        headings,
+        warnings,
+        normal,
     )
 
 

@@ -40,6 +40,10 @@ DERIVED = {
     "critical_impulse_ratio": "mu_c",
 }
 UNBOUNDED = 1e3
+NO_ANGLE = (
+    "no evidence reaches the crush-surface angle: a point impulse (Px, Py) fits any; give "
+    "impact.normal_angle (a number or a distribution)"
+)
 NO_NORMAL = (
     "needs impact.normal_angle: the impulse (Px, Py) does not say how it splits into normal and "
     "tangential parts"
@@ -77,7 +81,8 @@ def quantities(model: Model, x, gradients: bool = True) -> dict:
         out = model.derived(x, gradients)
         for path, name in {**DERIVED, **ENERGY_PARTS}.items():
             value = out[name] if out["status"] == 0 else math.nan
-            q[path] = (value, out.get(f"grad_{name}"), path.startswith("impulse."))
+            # with an uncertain normal angle even Pn, Pt are not affine in x alone
+            q[path] = (value, out.get(f"grad_{name}"), path.startswith("impulse.") and case.normal is None)
         q["_derived"] = out
     return q
 
@@ -203,7 +208,7 @@ def fit(scene: Mapping | str | Path, draws: int = 400, seed: int = 0, method: st
     model, x_hat, y, ident, samples, info = fit_case(case, draws, seed, method)
     at = quantities(model, x_hat)
     derived = at.pop("_derived", None)
-    drawn = _drawn(model, samples)
+    drawn = _drawn(model, samples, _normal_draws(case, len(samples), seed))
     estimates = {
         p: _estimate(p, v, g, aff, ident, info["linear"], drawn.get(p), derived, case.unknowns)
         for p, (v, g, aff) in at.items()
@@ -211,6 +216,14 @@ def fit(scene: Mapping | str | Path, draws: int = 400, seed: int = 0, method: st
     if not case.has_normal:
         for path in (*DERIVED, *ENERGY_PARTS):
             estimates[path] = Estimate(None, determined=False, why=NO_NORMAL)
+        estimates["impact.normal_angle"] = Estimate(None, determined=False, why=NO_ANGLE)
+    elif case.normal is not None:
+        degrees = np.degrees(_normal_draws(case, 4000, seed))
+        estimates["impact.normal_angle"] = Estimate(
+            math.degrees(case.params["gamma"]),
+            float(np.std(degrees)),
+            tuple(float(v) for v in np.percentile(degrees, [5, 95])),
+        )
     residuals, worst = _residuals(case, model, y)
     unbounded = [p for p, e in estimates.items() if e.determined and e.interval and None in e.interval]
     if unbounded:
@@ -259,15 +272,33 @@ def _end(value):
     return None if value is None else json_number(value)
 
 
-def _drawn(model: Model, samples) -> dict:
-    """path -> array of the quantity over the Monte Carlo draws."""
+def _normal_draws(case: FitCase, n: int, seed: int):
+    """n draws of the normal angle [rad] from its distribution (None when it is a plain number)."""
+    if case.normal is None or n == 0:
+        return None
+    kind, params, offset = case.normal
+    rng = np.random.default_rng([seed, 24])
+    degrees = {"normal": rng.normal, "uniform": rng.uniform, "triangular": rng.triangular}[kind](
+        *params, size=n
+    )
+    return np.radians(degrees + offset)
+
+
+def _drawn(model: Model, samples, gammas=None) -> dict:
+    """path -> array of the quantity over the Monte Carlo draws (each draw with
+    its own normal angle when the scene gives a distribution for it)."""
     if not samples:
         return {}
-    rows = []
-    for x in samples:
-        q = quantities(model, x, gradients=False)
-        q.pop("_derived", None)
-        rows.append({p: v[0] for p, v in q.items()})
+    rows, nominal = [], model.case.params["gamma"]
+    try:
+        for k, x in enumerate(samples):
+            if gammas is not None:
+                model.case.params["gamma"] = float(gammas[k])
+            q = quantities(model, x, gradients=False)
+            q.pop("_derived", None)
+            rows.append({p: v[0] for p, v in q.items()})
+    finally:
+        model.case.params["gamma"] = nominal
     return {p: np.array([r[p] for r in rows], dtype=float) for p in rows[0]}
 
 
