@@ -225,34 +225,8 @@ def fit(scene: Mapping | str | Path, draws: int = 400, seed: int = 0, method: st
             tuple(float(v) for v in np.percentile(degrees, [5, 95])),
         )
     residuals, worst = _residuals(case, model, y)
-    unbounded = [p for p, e in estimates.items() if e.determined and e.interval and None in e.interval]
-    if unbounded:
-        warnings_unbounded = [
-            f"the 90 % interval of {', '.join(unbounded)} is unbounded on one side: the evidence lets it run "
-            "away (its end is null; e.g. a departure direction close to the heading allows any speed)"
-        ]
-    else:
-        warnings_unbounded = []
-    warnings = list(case.warnings)
     flags = _flags(derived, estimates)
-    warnings += describe_flags(flags) + warnings_unbounded
-    if derived is not None and derived["status"] != 0:
-        warnings.append(
-            f"e, mu and mu_c are not defined at the estimate: {describe_status(derived['status'])}"
-        )
-    dof = len(model.values) - ident.rank
-    if worst is not None and dof > 0 and abs(worst["z"]) > 1e-6:
-        warnings.append(
-            f"evidence[{worst['evidence']}] ({worst['label']}) disagrees most with the fit: z = {worst['z']:.3g}"
-            + (" (beyond 3 standard deviations)" if abs(worst["z"]) > 3 else "")
-        )
-    elif worst is not None:
-        warnings.append("the fit reproduces every item: no evidence checks another")
-    if ident.rank < len(case.unknowns) - (1 if case.moment else 0):
-        names = [p for p, e in estimates.items() if not e.determined and p in case.unknowns]
-        warnings.append(
-            f"the evidence does not determine {', '.join(names) or 'every unknown'} (see identifiability)"
-        )
+    warnings = _warnings(case, len(model.values), ident.rank, estimates, derived, flags, worst)
     return FitResult(
         units=case.units,
         names=case.names,
@@ -266,6 +240,33 @@ def fit(scene: Mapping | str | Path, draws: int = 400, seed: int = 0, method: st
         info=info | {"draws": len(samples)},
         warnings=warnings,
     )
+
+
+def _warnings(case: FitCase, observations: int, rank: int, estimates, derived, flags, worst) -> list[str]:
+    """The answer's warnings: the scene's, the admissibility flags, interval ends
+    that run away, the item that disagrees most, the unknowns not determined."""
+    warnings = list(case.warnings) + describe_flags(flags)
+    unbounded = [p for p, e in estimates.items() if e.determined and e.interval and None in e.interval]
+    if unbounded:
+        warnings.append(
+            f"the 90 % interval of {', '.join(unbounded)} is unbounded on one side: the evidence lets it run "
+            "away (its end is null; e.g. a departure direction close to the heading allows any speed)"
+        )
+    if derived is not None and derived["status"] != 0:
+        warnings.append(
+            f"e, mu and mu_c are not defined at the estimate: {describe_status(derived['status'])}"
+        )
+    if worst is not None and observations > rank and abs(worst["z"]) > 1e-6:
+        warnings.append(
+            f"evidence[{worst['evidence']}] ({worst['label']}) disagrees most with the fit: z = {worst['z']:.3g}"
+            + (" (beyond 3 standard deviations)" if abs(worst["z"]) > 3 else "")
+        )
+    elif worst is not None:
+        warnings.append("the fit reproduces every item: no evidence checks another")
+    missing = [p for p, e in estimates.items() if not e.determined and p in case.unknowns]
+    if missing:
+        warnings.append(f"the evidence does not determine {', '.join(missing)} (see identifiability)")
+    return warnings
 
 
 def _end(value):
