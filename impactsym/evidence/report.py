@@ -58,14 +58,14 @@ def residual_chart(result, out: str) -> None:
     """Normalised residual z of every observation, ±1 and ±2 bands."""
     from .._util import require
 
-    require("matplotlib", extra="plot", what="a residual chart")
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    require("matplotlib", extra="plot", what="a residual chart", load=False)
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
     rows = result.residuals
-    fig, ax = plt.subplots(figsize=(7, 0.45 * len(rows) + 1.5))
+    fig = Figure(figsize=(7, 0.45 * len(rows) + 1.5), layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
     z = [r["z"] or 0.0 for r in rows]
     names = [f"[{r['evidence']}] {_label(r['label'], result.names)}" for r in rows]
     ax.axvspan(-2, 2, color="0.92")
@@ -76,9 +76,7 @@ def residual_chart(result, out: str) -> None:
     ax.axvline(0, color="k", lw=0.8)
     ax.set_xlabel("normalised residual z = (fitted - value) / sd")
     ax.set_title("fit residuals per evidence item")
-    fig.tight_layout()
     fig.savefig(out, dpi=120)
-    plt.close(fig)
 
 
 def scene_picture(result, scene, out: str) -> None:
