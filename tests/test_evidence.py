@@ -324,8 +324,23 @@ def test_barrier_crush_energy_is_the_energy_loss():
     assert got["impulse_ratio"] == pytest.approx(0.1, rel=1e-6)
     two_moving = with_evidence(truth(1), LINEAR)
     two_moving["evidence"].append({"vehicle": 0, "quantity": "crush_energy", "value": 1e5, "sd": 1e4})
-    with pytest.raises(SceneError, match="crush energy is the energy loss only against a fixed barrier"):
+    with pytest.raises(SceneError, match="give one crush_energy per moving vehicle"):
         fit(two_moving, draws=0)
+
+
+def test_crush_energies_of_both_vehicles_are_the_energy_loss():
+    """CRASH3's energy dissipated: E1 + E2 = T_L (sds in quadrature)."""
+    t = truth(19)
+    scene = with_evidence(t, [("speed", 0), ("final_direction", 0), ("final_direction", 1)])
+    share = 0.4 * t["ref"]["TL"]
+    scene["evidence"] += [
+        {"vehicle": 0, "quantity": "crush_energy", "value": share, "sd": 3000.0},
+        {"vehicle": 1, "quantity": "crush_energy", "value": t["ref"]["TL"] - share, "sd": 4000.0},
+    ]
+    got = fit(scene, draws=0).to_json_dict()
+    energy = [r for r in got["residuals"] if r["label"].startswith("energy_loss.total")]
+    assert len(energy) == 1 and energy[0]["value"] == pytest.approx(t["ref"]["TL"], rel=1e-12)
+    assert got["vehicles"][1]["speed"] == pytest.approx(t["speeds"][1], rel=1e-6)
 
 
 def test_an_uncertain_normal_angle_widens_e_and_mu_not_the_speeds():

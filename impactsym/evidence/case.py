@@ -43,7 +43,7 @@ from ..casefile import (
 from ..errors import SceneError, show_value
 from ..scene import scene_data
 from .edr_item import edr_observations
-from .items import EVIDENCE_KEYS, Observation, read_item
+from .items import EVIDENCE_KEYS, Observation, crush_energies, read_item
 
 STATE = ("v1x", "v1y", "w1", "v2x", "v2y", "w2", "Px", "Py", "M")
 
@@ -137,6 +137,7 @@ def read_case(source: Mapping | str | Path) -> FitCase:
             observations += edr_observations(item, k, units, names, fixed, source, warnings)
         else:
             observations += read_item(item, k, units, names, fixed)
+    observations = crush_energies(observations, fixed)
     yaw_observed = {o.how[1] for o in observations if o.how[0] == "state"}
     for i in range(2):
         if f"w{i + 1}" in yaw_observed and f"vehicles[{i}].yaw_rate" not in values and not fixed[i]:

@@ -159,16 +159,33 @@ def read_item(item: Any, k: int, units: str, names, fixed) -> list[Observation]:
         "energy_loss": ("energy",),
         "crush_energy": ("energy",),
     }[quantity]
-    if quantity == "crush_energy" and not fixed[1 - i]:
-        raise SceneError(
-            "one vehicle's crush energy is the energy loss only against a fixed barrier; with two "
-            "moving vehicles give energy_loss (the CRASH3 total of both, crash3 --json energy_total)",
-            f"{path}.quantity",
-        )
-    label = (
-        "energy_loss.total" if quantity in ("energy_loss", "crush_energy") else f"vehicles[{i}].{quantity}"
-    )
+    label = "energy_loss.total" if quantity == "energy_loss" else f"vehicles[{i}].{quantity}"
     return [Observation(k, label, value, sd, how, angle=dimension == "angle")]
+
+
+def crush_energies(observations: list[Observation], fixed) -> list[Observation]:
+    """CRASH3's energy "dissipated" (conventions.md): the crush energies of the
+    vehicles together are the energy loss. Against a fixed barrier one vehicle's
+    is; two moving vehicles need both (their sum, the sds in quadrature)."""
+    crush = [o for o in observations if o.label.endswith(".crush_energy")]
+    if not crush:
+        return observations
+    moving = [i for i in (0, 1) if not fixed[i]]
+    crushed = sorted({int(o.label[len("vehicles[")]) for o in crush})
+    if len(crush) != len(moving) or crushed != moving:
+        raise SceneError(
+            "crush energies are the energy loss of the impact only together: give one crush_energy per "
+            "moving vehicle (one against a fixed barrier), or energy_loss (crash3 --json energy_total)",
+            f"evidence[{crush[0].evidence}].quantity",
+        )
+    total = Observation(
+        crush[0].evidence,
+        "energy_loss.total" if len(crush) == 1 else "energy_loss.total (sum of the crush energies)",
+        sum(o.value for o in crush),
+        math.sqrt(sum(o.sd**2 for o in crush)),
+        ("energy",),
+    )
+    return [o for o in observations if o not in crush] + [total]
 
 
 def module_at(item: Mapping, path: str, units: str) -> tuple[float, float]:
