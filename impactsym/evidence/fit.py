@@ -227,6 +227,8 @@ def fit(scene: Mapping | str | Path, draws: int = 400, seed: int = 0, method: st
     residuals, worst = _residuals(case, model, y)
     flags = _flags(derived, estimates)
     warnings = _warnings(case, len(model.values), ident.rank, estimates, derived, flags, worst)
+    if not info["converged"]:
+        warnings.append(f"Gauss-Newton stopped after {info['iterations']} iterations without converging")
     return FitResult(
         units=case.units,
         names=case.names,

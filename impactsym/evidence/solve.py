@@ -62,7 +62,10 @@ def _scaled_pinv_step(Jw, r):
     return step / scale
 
 
-def gauss_newton(model: Model, xp, N, u0, values=None, max_iter=60):
+MAX_ITERATIONS = 60
+
+
+def gauss_newton(model: Model, xp, N, u0, values=None, max_iter=MAX_ITERATIONS):
     """Minimise |r|² over u (x = xp + N u) from u0; returns (u, iterations)."""
     saved = model.values
     if values is not None:
@@ -261,6 +264,7 @@ def fit_case(case: FitCase, draws: int = 400, seed: int = 0, method: str = "auto
     info = {
         "linear": linear,
         "iterations": iterations,
+        "converged": iterations < MAX_ITERATIONS,
         "method": "closed form" if iterations == 0 else "gauss-newton",
     }
     return model, x_hat, y, ident, samples, info
