@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SceneError
+from ..result import json_number
 from ..units import GRAVITY, STANDARD_GRAVITY, registry
 
 END_WINDOW_MS = 20.0
@@ -62,11 +63,11 @@ class Pulse:
         return {
             "units": units,
             "delta_v": {
-                "longitudinal": float(lon),
-                "lateral": float(lat),
-                "magnitude": math.hypot(lon, lat),
-                "direction": math.degrees(math.atan2(lat, lon)),
-                "time_of_max": float(self.time[self.peak] * 1000.0),
+                "longitudinal": json_number(float(lon)),
+                "lateral": json_number(float(lat)),
+                "magnitude": json_number(math.hypot(lon, lat)),
+                "direction": json_number(math.degrees(math.atan2(lat, lon))),
+                "time_of_max": json_number(float(self.time[self.peak] * 1000.0)),
             },
             "lateral_positive": "left",
             "ended": self.ended,
@@ -90,7 +91,8 @@ class PreCrash:
 
     def to_json_dict(self, units: str = "SI") -> dict:
         scale = 1.0 if units == "SI" else 1.0 / 0.3048
-        return {"units": units, "speed": self.at_crash() * scale, "samples": len(self.time), "warnings": []}
+        speed = json_number(self.at_crash() * scale)
+        return {"units": units, "speed": speed, "samples": len(self.time), "warnings": []}
 
 
 def _unit_factor(unit: str, target: str, where: str) -> float:
