@@ -14,6 +14,7 @@ SUBCOMMANDS = {
     "accuracy": "benchmarks.accuracy",
     "body": "benchmarks.body",
     "drivers": "benchmarks.drivers",
+    "evidence": "benchmarks.evidence",
     "inverse": "benchmarks.inverse",
     "performance": "benchmarks.performance",
     "uncertainty": "benchmarks.uncertainty",

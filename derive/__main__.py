@@ -39,6 +39,7 @@ MODEL_MODULES = (
     "crash3",
     "report",
     "jacobian",
+    "evidence",
 )
 # Proved before emission but emitting no module of their own (emit inlines their source).
 PROOF_ONLY_MODULES = ("trig",)
@@ -46,7 +47,7 @@ PROOF_ONLY_MODULES = ("trig",)
 # once per scene with the plain-Python function, and a driver returning the
 # 100-300 outputs of a Jacobian does not compile (numba has no LIST_TO_TUPLE,
 # which CPython uses for tuples of more than 30 values).
-PER_SCENE_ONLY_MODULES = ("jacobian",)
+PER_SCENE_ONLY_MODULES = ("jacobian", "evidence")
 ROOT = Path(__file__).resolve().parent.parent
 
 

@@ -45,12 +45,17 @@ def _tangent_symbol(sym: sp.Symbol, wrt: sp.Symbol) -> sp.Symbol:
     return real(derivative_name(Kernel.public_name(sym), wrt.name))
 
 
-def jacobian_kernel(base: Kernel, name: str | None = None) -> Kernel:
-    """`base` plus the exact derivatives of its outputs with respect to its inputs.
+def jacobian_kernel(
+    base: Kernel, name: str | None = None, wrt: tuple | None = None, family: str = "jacobian"
+) -> Kernel:
+    """`base` plus the exact derivatives of its outputs with respect to its inputs
+    (or to the inputs `wrt` only), in the registry's `family` (the Jacobians of
+    the value kernels by default; a family whose kernels carry their own
+    derivatives, such as the evidence fit's, names itself).
 
     Blocks that only feed the physics flags (the flag tolerances, sums of
     absolute values) get no derivative blocks: no output depends on them."""
-    wrt = tuple(base.inputs)
+    wrt = tuple(base.inputs) if wrt is None else tuple(wrt)
     tangents = {x: {x: sp.Integer(1)} for x in wrt}
     needed = _needed_by_outputs(base)
     blocks = []
@@ -84,7 +89,7 @@ def jacobian_kernel(base: Kernel, name: str | None = None) -> Kernel:
         blocks=tuple(blocks),
         outputs=tuple(base.outputs) + tuple(outputs),
         constants=tuple(base.constants) + tuple(zeros),
-        family="jacobian",
+        family=family,
         variant=(("of", base.name),),
     )
 

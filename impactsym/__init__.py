@@ -23,6 +23,7 @@ from .codes import FLAG_MESSAGES, STATUS_MESSAGES, describe_flags, describe_stat
 from .compare import compare
 from .crash3 import crash3
 from .energy import delta_v_from_energy
+from .evidence import fit, read_edr
 from .explore import explore
 from .inverse import invert, invert_batch
 from .reconstruct import reconstruct, reconstruct_batch
@@ -46,10 +47,12 @@ __all__ = [
     "describe_flags",
     "describe_status",
     "explore",
+    "fit",
     "invert",
     "invert_batch",
     "load_scene",
     "percentiles",
+    "read_edr",
     "plot",
     "reconstruct",
     "reconstruct_batch",

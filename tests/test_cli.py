@@ -16,7 +16,7 @@ from tests.helpers import run_cli as run
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 # Forward scenes; the other kinds are named by their command (invert_*, reconstruct_*, ...).
-OTHER_KINDS = ("invert_", "reconstruct_", "crash3_")
+OTHER_KINDS = ("invert_", "reconstruct_", "crash3_", "fit_")
 EXAMPLE_FILES = [
     path
     for path in sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml"))

@@ -122,7 +122,7 @@ def test_conventions_document_every_scene_key_of_the_examples(path):
 
 def _command(path: Path) -> str:
     """The command an example is for, from its name (examples/README.md)."""
-    for command in ("invert", "reconstruct", "crash3"):
+    for command in ("invert", "reconstruct", "crash3", "fit"):
         if path.name.startswith(command):
             return command
     return "compare" if path.name.startswith("models") else "solve"

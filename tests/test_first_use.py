@@ -254,7 +254,12 @@ def test_json_never_prints_negative_zero():
 
 def _command(path: Path) -> str:
     """The command an example is written for (by its name's prefix)."""
-    for prefix, command in (("invert_", "invert"), ("reconstruct_", "reconstruct"), ("crash3_", "crash3")):
+    for prefix, command in (
+        ("invert_", "invert"),
+        ("reconstruct_", "reconstruct"),
+        ("crash3_", "crash3"),
+        ("fit_", "fit"),
+    ):
         if path.name.startswith(prefix):
             return command
     return "solve"

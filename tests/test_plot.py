@@ -17,7 +17,7 @@ EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 FORWARD = [
     p
     for p in sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml"))
-    if not p.name.startswith(("invert_", "reconstruct_", "crash3_"))
+    if not p.name.startswith(("invert_", "reconstruct_", "crash3_", "fit_"))
 ]
 MIN_PNG_BYTES = 20_000  # a blank 9x6.5 in figure at 120 dpi is about 8 kB
 

@@ -27,7 +27,7 @@ EXAMPLES = FilePath(__file__).resolve().parent.parent / "examples"
 FORWARD = [
     p
     for p in sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml"))
-    if not p.name.startswith(("invert_", "reconstruct_", "crash3_"))
+    if not p.name.startswith(("invert_", "reconstruct_", "crash3_", "fit_"))
 ]
 CASES = (
     [(impactsym.solve, p) for p in FORWARD]

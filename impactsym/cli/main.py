@@ -11,6 +11,7 @@ import sys
 from contextlib import suppress
 
 from .._version import __version__
+from ..evidence import cli as evidence_cli
 from ..scene import SceneError
 from .common import EXIT_INTERRUPTED, EXIT_TERMINATED, PROG, Command, UsageError, _fail, _Parser
 from .scene_commands import (
@@ -75,6 +76,7 @@ COMMANDS: dict[str, Command] = {
         _run_validate,
     ),
 }
+COMMANDS.update({name: Command(*spec) for name, spec in evidence_cli.COMMANDS.items()})
 
 
 def build_parser() -> argparse.ArgumentParser:
