@@ -33,6 +33,8 @@ PROOF_ONLY_MODULES = ("trig",)
 # 100-300 outputs of a Jacobian does not compile (numba has no LIST_TO_TUPLE,
 # which CPython uses for tuples of more than 30 values).
 PER_SCENE_ONLY_MODULES = ("jacobian",)
+# Families that write their own files (a loop, not straight-line kernels): render(digest) -> {name: text}.
+RENDERED_MODULES = ("runout",)
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -62,8 +64,10 @@ def render_all() -> dict[str, str]:
         )
         if drivers:
             files[f"{name}_jit.py"] = emit.render_jit_module(f"{name}.py", kernels, digest)
+    for name in RENDERED_MODULES:
+        files.update(importlib.import_module(f"derive.{name}").render(digest))
     files["codes.py"] = emit.render_codes(digest)
-    files["__init__.py"] = emit.render_init(MODEL_MODULES, digest)
+    files["__init__.py"] = emit.render_init(MODEL_MODULES + RENDERED_MODULES, digest)
     return files
 
 
@@ -72,7 +76,7 @@ def run_proofs() -> bool:
     import importlib
 
     ok = True
-    for name in MODEL_MODULES + PROOF_ONLY_MODULES:
+    for name in MODEL_MODULES + PROOF_ONLY_MODULES + RENDERED_MODULES:
         for claim, passed in importlib.import_module(f"derive.{name}").proofs():
             print(f"  [{'ok' if passed else 'FAILED'}] {claim}")
             ok = ok and bool(passed)

@@ -32,6 +32,7 @@ from .inverse import invert
 from .plot import add_plot_argument, save_plot
 from .reconstruct import reconstruct
 from .result import UNIT_LABELS, json_clean, json_number, table_cell
+from .runout import cli as runout_cli
 from .scene import SceneError
 from .single import solve
 from .sweep import (
@@ -566,6 +567,7 @@ COMMANDS: dict[str, Command] = {
         _run_validate,
     ),
 }
+COMMANDS["runout"] = Command(runout_cli.HELP, runout_cli.add_arguments, runout_cli.run)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,76 @@
+"""`impactsym runout SCENE [--json] [--path] [--plot OUT.png]`.
+
+Registered in impactsym/cli.py's COMMANDS (help, add_arguments, run). A bad
+scene raises SceneError, which the command line prints as one line (exit 2).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from ..result import json_clean
+from .api import runout
+
+HELP = "post-impact run-out: each vehicle from separation to rest, or its separation velocity fitted to rest"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The command's arguments."""
+    parser.add_argument("scene", help="scene file (.json or .toml) with a runout object")
+    parser.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    parser.add_argument("--path", action="store_true", help="add each vehicle's path [[t, x, y, psi], ...]")
+    parser.add_argument("--plot", metavar="OUT.png", help="draw the paths, outlines, tyre marks and poses")
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Add the ``runout`` sub-command to an argparse sub-parser set."""
+    parser = subparsers.add_parser("runout", help=HELP, description=HELP)
+    add_arguments(parser)
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the command; 0 on success (bad input raises SceneError)."""
+    from .scene import load_runout
+
+    scene = load_runout(args.scene)
+    result = runout(scene, path=bool(args.path or args.plot))
+    if args.plot:
+        from .plot import plot_runout
+
+        plot_runout(scene, result, args.plot)
+    if not args.path:
+        for entry in result["vehicles"]:
+            entry.pop("path", None)
+    if args.json:
+        print(json.dumps(json_clean(result)))
+    else:
+        print(table(result))
+    return 0
+
+
+def table(result: dict) -> str:
+    """The result for people: one block per vehicle."""
+    unit = "ft" if result["units"] == "US" else "m"
+    lines = []
+    for v in result["vehicles"]:
+        sep, rest = v["separation"], v["rest"]
+        fitted = " (fitted to rest)" if "fit" in v else ""
+        lines += [
+            f"{v['name']}",
+            f"  separation{fitted}: velocity [{sep['velocity'][0]:.3f}, {sep['velocity'][1]:.3f}] {unit}/s "
+            f"(speed {sep['speed']:.3f}), yaw rate {sep['yaw_rate']:.4f} rad/s",
+            f"  rest: position [{rest['position'][0]:.3f}, {rest['position'][1]:.3f}] {unit}, "
+            f"heading {rest['heading']:.2f} deg",
+            f"  time {v['time']:.3f} s, distance {v['distance']:.3f} {unit}, rotation {v['rotation']:.2f} deg",
+        ]
+        res = v.get("fit", v).get("residual")
+        if res is not None:
+            extra = f", {v['fit']['iterations']} iterations" if "fit" in v else ""
+            lines.append(
+                f"  residual against the measured rest: {res['position']:.2g} {unit}, "
+                f"{res['heading']:.2g} deg{extra}"
+            )
+    lines += [f"warning: {w}" for w in result["warnings"]]
+    return "\n".join(lines)

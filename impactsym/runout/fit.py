@@ -1,0 +1,195 @@
+"""Fit a vehicle's separation velocity (vx, vy, w) to its measured rest pose.
+
+Newton's method on the three unknowns with the exact sensitivities
+d(x, y, psi)_rest/d(vx, vy, w) that the kernel integrates alongside the motion
+(generated/runout_jit.py, derive/runout.py), with a backtracking line search on
+the residual (heading weighted by the vehicle's wheel radius R_max, so that one
+radian counts as R_max metres).
+
+Starting estimate (documented; "straight slide plus spin energy"): the vehicle
+travels straight from the separation to the rest position, d = |rest - sep|,
+and turns by dpsi = psi_rest - psi_sep. Its kinetic energy goes into friction:
+translation ``v0 = sqrt(2 mu_e g d)`` along rest - sep, rotation
+``w0 = sgn(dpsi) sqrt(2 mu_e g sum(N_k |r_k|) |dpsi| / (I g))``, with mu_e the
+wheels' mean longitudinal coefficient (mu locked, b mu braked, f_r rolling,
+weighted by load) blended toward mu as the rotation grows to 90 deg (a
+rotating vehicle slides its rolling wheels sideways).
+
+Starts: the estimate is refined by a scan of forward run-outs (speed x 0.7, 1,
+1.3; yaw rate x 1, 0.5, 0, -0.5); Newton starts from the candidate nearest the
+rest pose. Uniqueness: Newton also runs from the next two candidates; converged
+states that differ from the reported one by more than 0.05 m/s or 0.02 rad/s
+are named in the warnings (the reported one is the converged state nearest the
+estimate).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .batch import columns, run_row
+from .scene import RunoutVehicle, row_values
+
+MAX_ITERATIONS = 40
+POSITION_TOL = 1e-4  # m
+HEADING_TOL = 1e-5  # rad
+DISTINCT_SPEED = 0.05  # m/s
+DISTINCT_YAW = 0.02  # rad/s
+SPEED_SCALES = (0.7, 1.0, 1.3)
+YAW_SCALES = (1.0, 0.5, 0.0, -0.5)
+UNIQUE_STARTS = 2
+UNIQUE_BUDGET = 12  # run-outs per extra start
+LOOSE_TOL = 1e-5  # integrator tolerance of the scan and the extra starts (they only compare states)
+
+
+@dataclass
+class Fit:
+    """A fitted separation state (SI) and how well it reaches the rest pose."""
+
+    velocity: tuple[float, float]
+    yaw_rate: float
+    residual_position: float  # m
+    residual_heading: float  # rad (absolute)
+    iterations: int
+    converged: bool
+    start: tuple[float, float, float]
+    alternatives: list = field(default_factory=list)
+
+
+def _wheel_table(row: dict):
+    """(loads N_k, |r_k|, longitudinal coefficients c_k) of the four wheels."""
+    wb, a, half, m, g = row["L"], row["a"], row["track"] / 2, row["m"], row["g"]
+    b = wb - a
+    loads = np.array([m * g * b / (2 * wb)] * 2 + [m * g * a / (2 * wb)] * 2)
+    radii = np.array([math.hypot(a, half)] * 2 + [math.hypot(b, half)] * 2)
+    coeff = []
+    for k in ("fl", "fr", "rl", "rr"):
+        if row[f"state_{k}"] == 1.0:
+            coeff.append(row["mu"])
+        elif row[f"brake_{k}"] > 0:
+            coeff.append(row[f"brake_{k}"] * row["mu"])
+        else:
+            coeff.append(row["f_r"])
+    return loads, radii, np.array(coeff)
+
+
+def starting_estimate(vehicle: RunoutVehicle) -> tuple[float, float, float]:
+    """(vx, vy, w) from straight slide plus spin energy (module docstring)."""
+    row = vehicle.row
+    x_r, y_r, psi_r = vehicle.rest
+    dx, dy = x_r - vehicle.position[0], y_r - vehicle.position[1]
+    d, dpsi = math.hypot(dx, dy), psi_r - vehicle.heading
+    loads, radii, coeff = _wheel_table(row)
+    along = float(loads @ coeff / loads.sum())
+    mu_e = along + (row["mu"] - along) * min(1.0, abs(dpsi) / (math.pi / 2))
+    v0 = math.sqrt(2 * mu_e * row["g"] * d)
+    w0 = math.copysign(math.sqrt(2 * mu_e * float(loads @ radii) * abs(dpsi) / row["I"]), dpsi)
+    return (v0 * dx / d, v0 * dy / d, w0) if d > 0 else (0.0, 0.0, w0)
+
+
+def _evaluate(vehicle, cols, p, tol):
+    """(residual vector, Jacobian) at p = (vx, vy, w); residual None if the run fails."""
+    y, _, status, _, _ = run_row(row_values(vehicle, cols, *p), tol=tol, sens=True)
+    if status != 0:
+        return None, None
+    x_r, y_r, psi_r = vehicle.rest
+    scale = _radius(vehicle.row)
+    r = np.array([y[0] - x_r, y[1] - y_r, (y[2] - psi_r) * scale])
+    S = y[7:].reshape(6, 4)
+    J = S[:3, :3].copy()
+    J[2] *= scale
+    return r, J
+
+
+def _radius(row) -> float:
+    return math.hypot(max(row["a"], row["L"] - row["a"]), row["track"] / 2)
+
+
+def _done(r, scale) -> bool:
+    return math.hypot(r[0], r[1]) < POSITION_TOL and abs(r[2]) / scale < HEADING_TOL
+
+
+def newton(vehicle: RunoutVehicle, start, tol: float | None = None, budget: int = MAX_ITERATIONS) -> Fit:
+    """Newton's method damped as Levenberg-Marquardt from `start` = (vx, vy, w):
+    the step solves (J'J + lam diag(J'J)) dp = -J'r; lam shrinks tenfold after a
+    step that lowers |r| and grows tenfold after one that does not (then the
+    step is retried from the same point). `budget` caps the run-outs."""
+    cols, scale = columns(), _radius(vehicle.row)
+    p = np.array(start, dtype=float)
+    r, J = _evaluate(vehicle, cols, p, tol)
+    iterations, runs, lam = 0, 1, 1e-3
+    while r is not None and not _done(r, scale) and runs < budget:
+        A, g = J.T @ J, J.T @ r
+        step = np.linalg.solve(A + lam * np.diag(np.diag(A) + 1e-12), -g)
+        trial = p + step
+        rt, Jt = _evaluate(vehicle, cols, trial, tol)
+        runs += 1
+        if rt is not None and float(rt @ rt) < float(r @ r):
+            p, r, J = trial, rt, Jt
+            lam = max(lam / 10, 1e-9)
+            iterations += 1
+        else:
+            lam *= 10
+            if lam > 1e8:
+                break
+    if r is None:
+        return Fit((math.nan, math.nan), math.nan, math.inf, math.inf, iterations, False, tuple(start))
+    return Fit(
+        (float(p[0]), float(p[1])),
+        float(p[2]),
+        math.hypot(r[0], r[1]),
+        abs(r[2]) / scale,
+        iterations,
+        bool(_done(r, scale)),
+        tuple(start),
+    )
+
+
+def _scan(vehicle: RunoutVehicle, estimate, tol) -> list:
+    """Candidate starts around the estimate, best residual first: speed x
+    SPEED_SCALES, yaw rate x YAW_SCALES, each run forward once."""
+    cols, scale = columns(), _radius(vehicle.row)
+    vx, vy, w = estimate
+    x_r, y_r, psi_r = vehicle.rest
+    found = []
+    for sv in SPEED_SCALES:
+        for sw in YAW_SCALES:
+            p = (vx * sv, vy * sv, w * sw)
+            y, _, status, _, _ = run_row(row_values(vehicle, cols, *p), tol=tol)
+            if status == 0:
+                res = math.hypot(math.hypot(y[0] - x_r, y[1] - y_r), (y[2] - psi_r) * scale)
+                found.append((res, p))
+    return [p for _, p in sorted(found)]
+
+
+def fit_rest(vehicle: RunoutVehicle, tol: float | None = None, check_unique: bool = True) -> Fit:
+    """The separation state reaching `vehicle.rest`. Newton starts from the
+    best of the scanned candidates around the documented estimate; with
+    `check_unique`, it also starts from the next UNIQUE_STARTS candidates and
+    their distinct converged solutions are attached as `alternatives`."""
+    estimate = starting_estimate(vehicle)
+    starts = _scan(vehicle, estimate, LOOSE_TOL) or [estimate]
+    fits = [newton(vehicle, starts[0], tol)]
+    for start in starts[1 : 1 + UNIQUE_STARTS] if check_unique else []:
+        fits.append(newton(vehicle, start, LOOSE_TOL, budget=UNIQUE_BUDGET))
+    good = [f for f in fits if f.converged]
+    if not good:
+        return fits[0]
+    est = np.array(estimate)
+    best = min(good, key=lambda f: _distance(f, est))
+    for f in good:
+        if f is not best and _distinct(f, best) and all(_distinct(f, g) for g in best.alternatives):
+            best.alternatives.append(f)
+    return best
+
+
+def _distance(f: Fit, est) -> float:
+    return float(np.linalg.norm(np.array([*f.velocity, f.yaw_rate]) - est))
+
+
+def _distinct(f: Fit, g: Fit) -> bool:
+    dv = math.hypot(f.velocity[0] - g.velocity[0], f.velocity[1] - g.velocity[1])
+    return dv > DISTINCT_SPEED or abs(f.yaw_rate - g.yaw_rate) > DISTINCT_YAW
