@@ -28,6 +28,7 @@ from .inverse import invert, invert_batch
 from .propagation import uncertainty
 from .reconstruct import reconstruct, reconstruct_batch
 from .result import Result
+from .runout import runout, runout_batch
 from .scene import MODELS, Impact, Scene, SceneError, Vehicle, load_scene
 from .single import solve
 from .sweep import percentiles, sample, sweep
@@ -54,6 +55,8 @@ __all__ = [
     "plot",
     "reconstruct",
     "reconstruct_batch",
+    "runout",
+    "runout_batch",
     "sample",
     "solve",
     "solve_batch",

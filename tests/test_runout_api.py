@@ -17,7 +17,7 @@ from impactsym.runout import load_runout, runout
 from impactsym.runout.fit import fit_rest
 
 ROOT = Path(__file__).resolve().parents[1]
-SEDAN = ROOT / "examples" / "runout_sedan.json"
+SEDAN = ROOT / "examples" / "runout" / "sedan.json"
 
 
 def _scene():
