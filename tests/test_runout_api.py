@@ -160,3 +160,31 @@ def test_cli_bad_scene_exits_2_with_one_line(tmp_path):
     proc = _cli(str(path), "--json")
     assert proc.returncode == 2
     assert proc.stderr.strip().count("\n") == 0 and "vehicles[0].mass" in proc.stderr
+
+
+def test_chain_solve_then_reconstruct_from_rest_recovers_the_pre_impact_speeds():
+    """pre-impact -> impact -> rest (solve_to_rest), then the rest poses back
+    to the pre-impact motion (reconstruct_from_rest): the given speeds return."""
+    from impactsym.runout.chain import reconstruct_from_rest, solve_to_rest
+
+    scene = json.loads((ROOT / "examples" / "runout" / "chain_solve.json").read_text())
+    forward = solve_to_rest(scene)
+    for v, out in zip(scene["vehicles"], forward["vehicles"]):
+        v["given"] = v.pop("velocity")
+        v["rest"] = out["rest"]
+    for key in ("restitution", "impulse_ratio", "moment_restitution"):
+        scene["impact"].pop(key)
+    given = [v.pop("given") for v in scene["vehicles"]]
+    back = reconstruct_from_rest(scene)
+    for v, g in zip(back["vehicles"], given):
+        assert v["runout"]["fit"]["converged"]
+        assert math.hypot(v["velocity"][0] - g[0], v["velocity"][1] - g[1]) < 0.01
+
+
+def test_cli_chain_reconstruct(tmp_path):
+    proc = _cli(
+        str(ROOT / "examples" / "runout" / "chain_reconstruct.json"), "--chain", "reconstruct", "--json"
+    )
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(proc.stdout)
+    assert {"speed", "velocity", "runout"} <= set(data["vehicles"][0])

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import json
 
+from ..errors import SceneError
 from ..result import json_clean
 from .api import runout
 
@@ -21,6 +22,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print the result as one JSON object")
     parser.add_argument("--path", action="store_true", help="add each vehicle's path [[t, x, y, psi], ...]")
     parser.add_argument("--plot", metavar="OUT.png", help="draw the paths, outlines, tyre marks and poses")
+    parser.add_argument(
+        "--chain",
+        choices=("solve", "reconstruct"),
+        help="solve: pre-impact -> impact -> rest (solve --json plus each rest); reconstruct: rest -> fitted "
+        "separation -> pre-impact (reconstruct --json plus each run-out)",
+    )
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -34,6 +41,8 @@ def run(args: argparse.Namespace) -> int:
     """Run the command; 0 on success (bad input raises SceneError)."""
     from .scene import load_runout
 
+    if args.chain:
+        return _run_chain(args)
     scene = load_runout(args.scene)
     result = runout(scene, path=bool(args.path or args.plot))
     if args.plot:
@@ -48,6 +57,36 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(table(result))
     return 0
+
+
+def _run_chain(args: argparse.Namespace) -> int:
+    """``--chain``: the impact command's JSON with the run-outs attached."""
+    from .chain import reconstruct_from_rest, solve_to_rest
+
+    if args.plot:
+        raise SceneError("--plot draws a plain run-out; leave out --chain to draw it", "--plot")
+    result = (solve_to_rest if args.chain == "solve" else reconstruct_from_rest)(args.scene, path=args.path)
+    print(json.dumps(json_clean(result)) if args.json else _chain_table(result))
+    return 0
+
+
+def _chain_table(result: dict) -> str:
+    lines = []
+    for v in result["vehicles"]:
+        ro = v.get("runout")
+        head = f"{v.get('name', '')}: velocity {v.get('velocity')}"
+        if ro is None:
+            lines.append(head)
+            continue
+        sep, rest = ro["separation"], ro["rest"]
+        lines += [
+            head,
+            f"  separation velocity [{sep['velocity'][0]:.3f}, {sep['velocity'][1]:.3f}], "
+            f"yaw rate {sep['yaw_rate']:.4f} rad/s",
+            f"  rest [{rest['position'][0]:.3f}, {rest['position'][1]:.3f}], heading {rest['heading']:.2f} deg",
+        ]
+    lines += [f"warning: {w}" for w in result.get("warnings", [])]
+    return "\n".join(lines)
 
 
 def table(result: dict) -> str:
