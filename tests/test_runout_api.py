@@ -188,3 +188,28 @@ def test_cli_chain_reconstruct(tmp_path):
     assert proc.returncode == 0, proc.stderr
     data = json.loads(proc.stdout)
     assert {"speed", "velocity", "runout"} <= set(data["vehicles"][0])
+
+
+def test_linear_separation_sensitivity_matches_a_refit():
+    """d(separation state)/d(rest pose, mu) from the integrated sensitivities
+    against fitting again to a moved rest pose and a changed friction."""
+    import numpy as np
+
+    from impactsym.runout.interval import separation_sensitivity
+
+    scene = _scene()
+    v = scene["vehicles"][0]
+    v["wheels"] = "locked"
+    v["separation"].update(velocity=[9.0, 2.0], yaw_rate=1.0)
+    rest = runout(scene)["vehicles"][0]["rest"]
+    del v["separation"]["velocity"], v["separation"]["yaw_rate"]
+    v["rest"] = rest
+    veh = load_runout(scene).vehicles[0]
+    base = fit_rest(veh)
+    A = separation_sensitivity(veh, base)
+    moved = copy.deepcopy(scene)
+    moved["vehicles"][0]["rest"]["position"][0] += 0.05
+    moved["runout"]["friction"] += 0.01
+    again = fit_rest(load_runout(moved).vehicles[0])
+    predicted = np.array([*base.velocity, base.yaw_rate]) + A @ [0.05, 0.0, 0.0, 0.01]
+    assert np.allclose([*again.velocity, again.yaw_rate], predicted, atol=2e-3)
