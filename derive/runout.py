@@ -488,10 +488,39 @@ INTEGRATOR_SOURCE = '''
 
 
 @__JIT__
-def _rhs(y, P, W, sens, f):
-    """State derivative f(y) (and with `sens` the sensitivity equations).
-    y = (x, y, psi, vx, vy, w, distance[, S]): m dv/dt = sum F, I dw/dt = sum Mz,
-    d distance/dt = |v| (conventions.md, run-out)."""
+def _rhs(y, P, W, f):
+    """State derivative f(y), y = (x, y, psi, vx, vy, w, distance):
+    m dv/dt = sum F, I dw/dt = sum Mz, d distance/dt = |v| (conventions.md, run-out)."""
+    c = math.cos(y[2])
+    s = math.sin(y[2])
+    vx, vy, w = y[3], y[4], y[5]
+    m, inertia, mu, amax, eps = P[0], P[1], P[2], P[3], P[4]
+    fx = 0.0
+    fy = 0.0
+    mz = 0.0
+    for k in range(4):
+        px, py, cd, sd, n = W[k, 0], W[k, 1], W[k, 2], W[k, 3], W[k, 4]
+        b, fre, cap = W[k, 5], W[k, 6], W[k, 7]
+        if W[k, 8] != 0.0:
+            r = _wheel_locked(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
+        else:
+            r = _wheel_rolling(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
+        fx += r[0]
+        fy += r[1]
+        mz += r[2]
+    f[0] = vx
+    f[1] = vy
+    f[2] = w
+    f[3] = fx/m
+    f[4] = fy/m
+    f[5] = mz/inertia
+    f[6] = math.sqrt(vx*vx + vy*vy)
+
+
+@__JIT__
+def _rhs_sens(y, P, W, f):
+    """_rhs and the sensitivity equations dS/dt = J S (+ df/dmu), S[i, j] =
+    y[7 + 4 i + j] = d y_i/d(vx, vy, w at separation, mu)_j."""
     c = math.cos(y[2])
     s = math.sin(y[2])
     vx, vy, w = y[3], y[4], y[5]
@@ -503,20 +532,11 @@ __ACC_INIT__
     for k in range(4):
         px, py, cd, sd, n = W[k, 0], W[k, 1], W[k, 2], W[k, 3], W[k, 4]
         b, fre, cap = W[k, 5], W[k, 6], W[k, 7]
-        if sens:
-            if W[k, 8] != 0.0:
-                r = _wheel_locked_jac(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
-            else:
-                r = _wheel_rolling_jac(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
-__ACC_ADD__
+        if W[k, 8] != 0.0:
+            r = _wheel_locked_jac(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
         else:
-            if W[k, 8] != 0.0:
-                r3 = _wheel_locked(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
-            else:
-                r3 = _wheel_rolling(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
-            fx += r3[0]
-            fy += r3[1]
-            mz += r3[2]
+            r = _wheel_rolling_jac(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
+__ACC_ADD__
     f[0] = vx
     f[1] = vy
     f[2] = w
@@ -524,7 +544,6 @@ __ACC_ADD__
     f[4] = fy/m
     f[5] = mz/inertia
     f[6] = math.sqrt(vx*vx + vy*vy)
-    if sens:
 __SENS__
 
 
@@ -534,83 +553,7 @@ def _speed(y, P):
     return math.sqrt(y[3]*y[3] + y[4]*y[4]) + abs(y[5])*P[5]
 
 
-@__JIT__
-def _integrate(y, P, W, sens, tol, path):
-    """Adaptive Dormand-Prince 5(4) (FSAL, local extrapolation) from t = 0 until
-    the vehicle stops (_speed < V_STOP), in place on y. The local error of the
-    state (x, y, psi, vx, vy, w) is kept below `tol` (absolute, SI) per step;
-    the distance and the sensitivities ride on the same steps. Accepted points
-    (t, x, y, psi) go to `path` while it has room. Returns (t, status, steps,
-    points)."""
-    n = y.shape[0]
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    k5 = np.empty(n)
-    k6 = np.empty(n)
-    k7 = np.empty(n)
-    z = np.empty(n)
-    t = 0.0
-    h = H0
-    steps = 0
-    points = 0
-    if path.shape[0] > 0:
-        path[0, 0], path[0, 1], path[0, 2], path[0, 3] = 0.0, y[0], y[1], y[2]
-        points = 1
-    if _speed(y, P) < V_STOP:
-        return t, STATUS_OK, steps, points
-    _rhs(y, P, W, sens, k1)
-    while True:
-        if steps >= MAX_STEPS or t >= T_MAX:
-            return t, STATUS_RUNOUT_NOT_STOPPED, steps, points
-        steps += 1
-        for i in range(n):
-            z[i] = y[i] + h*(0.2*k1[i])
-        _rhs(z, P, W, sens, k2)
-        for i in range(n):
-            z[i] = y[i] + h*(0.075*k1[i] + 0.225*k2[i])
-        _rhs(z, P, W, sens, k3)
-        for i in range(n):
-            z[i] = y[i] + h*((44.0/45.0)*k1[i] - (56.0/15.0)*k2[i] + (32.0/9.0)*k3[i])
-        _rhs(z, P, W, sens, k4)
-        for i in range(n):
-            z[i] = y[i] + h*((19372.0/6561.0)*k1[i] - (25360.0/2187.0)*k2[i] + (64448.0/6561.0)*k3[i]
-                             - (212.0/729.0)*k4[i])
-        _rhs(z, P, W, sens, k5)
-        for i in range(n):
-            z[i] = y[i] + h*((9017.0/3168.0)*k1[i] - (355.0/33.0)*k2[i] + (46732.0/5247.0)*k3[i]
-                             + (49.0/176.0)*k4[i] - (5103.0/18656.0)*k5[i])
-        _rhs(z, P, W, sens, k6)
-        for i in range(n):
-            z[i] = y[i] + h*((35.0/384.0)*k1[i] + (500.0/1113.0)*k3[i] + (125.0/192.0)*k4[i]
-                             - (2187.0/6784.0)*k5[i] + (11.0/84.0)*k6[i])
-        _rhs(z, P, W, sens, k7)
-        err = 0.0
-        for i in range(6):
-            e = h*((71.0/57600.0)*k1[i] - (71.0/16695.0)*k3[i] + (71.0/1920.0)*k4[i]
-                   - (17253.0/339200.0)*k5[i] + (22.0/525.0)*k6[i] - (1.0/40.0)*k7[i])
-            err = max(err, abs(e)/tol)
-        if not (err <= 1.0):  # rejected (NaN included)
-            if not math.isfinite(err):
-                h *= 0.1
-            else:
-                h *= max(0.2, 0.9*err**-0.2)
-            continue
-        t += h
-        for i in range(n):
-            y[i] = z[i]
-            k1[i] = k7[i]
-        if points < path.shape[0]:
-            path[points, 0], path[points, 1], path[points, 2], path[points, 3] = t, y[0], y[1], y[2]
-            points += 1
-        if _speed(y, P) < V_STOP:
-            return t, STATUS_OK, steps, points
-        grow = 5.0 if err < 1e-10 else min(5.0, 0.9*err**-0.2)
-        h = min(h*grow, H_MAX)
-
-
-@__JIT__
+__INTEGRATE__@__JIT__
 def _check(v):
     """The row's status before integration (0: fine). v holds the COLUMNS values."""
     for i in range(v.shape[0]):
@@ -658,36 +601,11 @@ def _setup(v, eps):
     return P, W
 
 
-@__JIT__
-def runout_row(v, tol, eps, sens, path):
-    """One run-out: v the COLUMNS values (SI, radians). Returns (y, t, status,
-    steps, points): y = (x, y, psi, vx, vy, w, distance) at rest, followed with
-    `sens` by the sensitivities S[i, j] = d y_i/d p_j at y[7 + 4 i + j],
-    p = (vx, vy, w at separation, mu)."""
-    n = 31 if sens else 7
-    y = np.zeros(n)
-    status = _check(v)
-    if status != STATUS_OK:
-        y[:] = np.nan
-        return y, np.nan, status, 0, 0
-    P, W = _setup(v, eps)
-    for i in range(6):
-        y[i] = v[9 + i]
-    if sens:
-        y[7 + 4*3 + 0] = 1.0
-        y[7 + 4*4 + 1] = 1.0
-        y[7 + 4*5 + 2] = 1.0
-    t, status, steps, points = _integrate(y, P, W, sens, tol, path)
-    if status != STATUS_OK:
-        y[:] = np.nan
-    return y, t, status, steps, points
-
-
-def _batch(c, out_x_rest, out_y_rest, out_psi_rest, out_t, out_distance, out_status, out_steps, tol, eps):
+__ROW__def _batch(c, out_x_rest, out_y_rest, out_psi_rest, out_t, out_distance, out_status, out_steps, tol, eps):
     """Rows of runout_row; c is the (rows, COLUMNS) input table."""
     empty = np.empty((0, 4))
     for i in prange(c.shape[0]):
-        y, t, status, steps, _ = runout_row(c[i], tol, eps, False, empty)
+        y, t, status, steps, _ = runout_row(c[i], tol, eps, empty)
         out_x_rest[i] = y[0]
         out_y_rest[i] = y[1]
         out_psi_rest[i] = y[2]
@@ -700,6 +618,103 @@ def _batch(c, out_x_rest, out_y_rest, out_psi_rest, out_t, out_distance, out_sta
 runout_batch = njit(cache=True, error_model="numpy", parallel=True)(_batch)
 runout_batch_serial = njit(cache=True, error_model="numpy")(_batch)
 '''
+INTEGRATE_TEMPLATE = '''@__JIT__
+def _integrate__SUFFIX__(y, P, W, tol, path):
+    """Adaptive Dormand-Prince 5(4) (FSAL, local extrapolation) from t = 0 until
+    the vehicle stops (_speed < V_STOP), in place on y. The local error of the
+    state (x, y, psi, vx, vy, w) is kept below `tol` (absolute, SI) per step;
+    the distance and the sensitivities ride on the same steps. Accepted points
+    (t, x, y, psi) go to `path` while it has room. Returns (t, status, steps,
+    points)."""
+    n = y.shape[0]
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    k5 = np.empty(n)
+    k6 = np.empty(n)
+    k7 = np.empty(n)
+    z = np.empty(n)
+    t = 0.0
+    h = H0
+    steps = 0
+    points = 0
+    if path.shape[0] > 0:
+        path[0, 0], path[0, 1], path[0, 2], path[0, 3] = 0.0, y[0], y[1], y[2]
+        points = 1
+    if _speed(y, P) < V_STOP:
+        return t, STATUS_OK, steps, points
+    _rhs__SUFFIX__(y, P, W, k1)
+    while True:
+        if steps >= MAX_STEPS or t >= T_MAX:
+            return t, STATUS_RUNOUT_NOT_STOPPED, steps, points
+        steps += 1
+        for i in range(n):
+            z[i] = y[i] + h*(0.2*k1[i])
+        _rhs__SUFFIX__(z, P, W, k2)
+        for i in range(n):
+            z[i] = y[i] + h*(0.075*k1[i] + 0.225*k2[i])
+        _rhs__SUFFIX__(z, P, W, k3)
+        for i in range(n):
+            z[i] = y[i] + h*((44.0/45.0)*k1[i] - (56.0/15.0)*k2[i] + (32.0/9.0)*k3[i])
+        _rhs__SUFFIX__(z, P, W, k4)
+        for i in range(n):
+            z[i] = y[i] + h*((19372.0/6561.0)*k1[i] - (25360.0/2187.0)*k2[i] + (64448.0/6561.0)*k3[i]
+                             - (212.0/729.0)*k4[i])
+        _rhs__SUFFIX__(z, P, W, k5)
+        for i in range(n):
+            z[i] = y[i] + h*((9017.0/3168.0)*k1[i] - (355.0/33.0)*k2[i] + (46732.0/5247.0)*k3[i]
+                             + (49.0/176.0)*k4[i] - (5103.0/18656.0)*k5[i])
+        _rhs__SUFFIX__(z, P, W, k6)
+        for i in range(n):
+            z[i] = y[i] + h*((35.0/384.0)*k1[i] + (500.0/1113.0)*k3[i] + (125.0/192.0)*k4[i]
+                             - (2187.0/6784.0)*k5[i] + (11.0/84.0)*k6[i])
+        _rhs__SUFFIX__(z, P, W, k7)
+        err = 0.0
+        for i in range(6):
+            e = h*((71.0/57600.0)*k1[i] - (71.0/16695.0)*k3[i] + (71.0/1920.0)*k4[i]
+                   - (17253.0/339200.0)*k5[i] + (22.0/525.0)*k6[i] - (1.0/40.0)*k7[i])
+            err = max(err, abs(e)/tol)
+        if not (err <= 1.0):  # rejected (NaN included)
+            if not math.isfinite(err):
+                h *= 0.1
+            else:
+                h *= max(0.2, 0.9*err**-0.2)
+            continue
+        t += h
+        for i in range(n):
+            y[i] = z[i]
+            k1[i] = k7[i]
+        if points < path.shape[0]:
+            path[points, 0], path[points, 1], path[points, 2], path[points, 3] = t, y[0], y[1], y[2]
+            points += 1
+        if _speed(y, P) < V_STOP:
+            return t, STATUS_OK, steps, points
+        grow = 5.0 if err < 1e-10 else min(5.0, 0.9*err**-0.2)
+        h = min(h*grow, H_MAX)
+
+
+'''
+ROW_TEMPLATE = '''@__JIT__
+def runout_row__SUFFIX__(v, tol, eps, path):
+    """One run-out: v the COLUMNS values (SI, radians). Returns (y, t, status,
+    steps, points): y = (x, y, psi, vx, vy, w, distance) at rest__DOC__."""
+    n = __N__
+    y = np.zeros(n)
+    status = _check(v)
+    if status != STATUS_OK:
+        y[:] = np.nan
+        return y, np.nan, status, 0, 0
+    P, W = _setup(v, eps)
+    for i in range(6):
+        y[i] = v[9 + i]
+__SINIT__    t, status, steps, points = _integrate__SUFFIX__(y, P, W, tol, path)
+    if status != STATUS_OK:
+        y[:] = np.nan
+    return y, t, status, steps, points
+
+
+'''
 ACC = [f"d{a}{k}" for a in "xyz" for k in range(5)]
 INTEGRATOR_SOURCE = (
     INTEGRATOR_SOURCE.replace("__JIT__", JIT)
@@ -707,9 +722,33 @@ INTEGRATOR_SOURCE = (
     .replace(
         "__ACC_ADD__",
         "\n".join(
-            ["            fx += r[0]", "            fy += r[1]", "            mz += r[2]"]
-            + [f"            {name} += r[{3 + i}]" for i, name in enumerate(ACC)]
+            ["        fx += r[0]", "        fy += r[1]", "        mz += r[2]"]
+            + [f"        {name} += r[{3 + i}]" for i, name in enumerate(ACC)]
         ),
     )
-    .replace("__SENS__", _sensitivity_lines())
+    .replace("__SENS__", "\n".join(line[4:] for line in _sensitivity_lines().splitlines()))
+    .replace(
+        "__INTEGRATE__",
+        INTEGRATE_TEMPLATE.replace("__SUFFIX__", "")
+        + "\n\n"
+        + INTEGRATE_TEMPLATE.replace("__SUFFIX__", "_sens"),
+    )
+    .replace(
+        "__ROW__",
+        ROW_TEMPLATE.replace("__SUFFIX__", "")
+        .replace("__N__", "7")
+        .replace("__DOC__", "")
+        .replace("__SINIT__", "")
+        + "\n\n"
+        + ROW_TEMPLATE.replace("__SUFFIX__", "_sens")
+        .replace("__N__", "31")
+        .replace(
+            "__DOC__",
+            ", then the sensitivities S[i, j] = d y_i/d p_j at y[7 + 4 i + j], p = (vx, vy, w at separation, mu)",
+        )
+        .replace(
+            "__SINIT__", "    y[7 + 4*3 + 0] = 1.0\n    y[7 + 4*4 + 1] = 1.0\n    y[7 + 4*5 + 2] = 1.0\n"
+        ),
+    )
+    .replace("__JIT__", JIT)
 )

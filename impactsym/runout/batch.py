@@ -102,11 +102,11 @@ def run_row(
     y[7 + 4 i + j]; `path` is (points, 4) of (t, x, y, psi) when asked."""
     plain, jit = _door.plain(), _door.jit()
     buffer = np.empty((path_points, 4))
-    y, t, status, steps, points = jit.runout_row(
+    row = jit.runout_row_sens if sens else jit.runout_row
+    y, t, status, steps, points = row(
         np.ascontiguousarray(values, dtype=np.float64),
         plain.TOL if tol is None else float(tol),
         plain.EPS if eps is None else float(eps),
-        sens,
         buffer,
     )
     return y, t, int(status), int(steps), buffer[:points]
