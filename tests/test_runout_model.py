@@ -133,3 +133,17 @@ def test_bad_rows_get_a_status_and_the_others_are_unaffected():
     assert out["status"][0] == 0 and math.isfinite(out["x_rest"][0])
     alone = runout_batch(rows_table(rows[:1]))
     assert alone["x_rest"][0] == out["x_rest"][0]
+
+
+def test_batch_refuses_a_missing_or_unknown_column_naming_it():
+    from impactsym.errors import SceneError
+
+    row = _row(1.0, vx=5.0)
+    cols = {k: np.array([v]) for k, v in row.items()}
+    del cols["mu"]
+    with pytest.raises(SceneError, match="^mu: missing column$"):
+        runout_batch(cols)
+    cols = {k: np.array([v]) for k, v in row.items()}
+    cols["muu"] = np.array([0.8])
+    with pytest.raises(SceneError, match="^muu: unknown column"):
+        runout_batch(cols)
