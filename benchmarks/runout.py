@@ -35,6 +35,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--rows", type=int, default=6, help="run-outs compared with the reference (default 6)"
     )
     parser.add_argument("--batch", type=int, default=2000, help="rows of the throughput batch (default 2000)")
+    parser.add_argument("--fits", type=int, default=20, help="random fit round trips (default 20)")
     parser.add_argument(
         "--out", type=Path, default=Path("benchmarks/results"), help="folder for runout.md/.png/.json"
     )
@@ -150,6 +151,47 @@ def _fit_timing() -> dict:
     return {"cases": cases}
 
 
+def _fit_random(n: int) -> dict:
+    """Round trips on random realistic run-outs: forward, then fitted to the rest
+    pose reached. Counts fits that converged, that recovered the generating
+    state (0.01 m/s, 0.01 rad/s; the reported state or a named alternative),
+    and that reached the rest pose from another state without naming it."""
+    from impactsym.runout.batch import run_row
+    from impactsym.runout.fit import fit_rest
+    from impactsym.runout.scene import RunoutVehicle
+    from tests.runout_rows import realistic_row
+
+    rng = np.random.default_rng(5)
+    counts = {"rows": n, "converged": 0, "recovered": 0, "other_state_unnamed": 0}
+    times = []
+    for _ in range(n):
+        row = realistic_row(rng)
+        y, _, _, _, _ = run_row(np.array([row[c] for c in _columns()]))
+        fixed = {k: v for k, v in row.items() if k not in ("vx", "vy", "w")}
+        veh = RunoutVehicle("r", fixed, (row["x"], row["y"]), row["psi"], None, None, (y[0], y[1], y[2]))
+        start = time.perf_counter()
+        fit = fit_rest(veh)
+        times.append(time.perf_counter() - start)
+        found = [fit, *fit.alternatives]
+        hit = any(
+            math.hypot(f.velocity[0] - row["vx"], f.velocity[1] - row["vy"]) < 0.01
+            and abs(f.yaw_rate - row["w"]) < 0.01
+            for f in found
+        )
+        counts["converged"] += fit.converged
+        counts["recovered"] += fit.converged and hit
+        counts["other_state_unnamed"] += fit.converged and not hit
+    counts["median_ms"] = float(np.median(times) * 1e3)
+    counts["max_ms"] = float(np.max(times) * 1e3)
+    return counts
+
+
+def _columns():
+    from impactsym.runout.batch import columns
+
+    return columns()
+
+
 def main(args: argparse.Namespace) -> int:
     from impactsym.testing.runout_reference import reference_runout
     from tests.runout_rows import realistic_row
@@ -176,6 +218,7 @@ def main(args: argparse.Namespace) -> int:
         "runouts_per_second_parallel": _throughput(args.batch),
         "runouts_per_second_one_thread_default_tol": 1.0 / default["seconds_per_runout"],
         "fit": _fit_timing(),
+        "fit_random": _fit_random(args.fits),
     }
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "runout.json").write_text(json.dumps(result, indent=1))
@@ -244,5 +287,13 @@ def _markdown(r: dict) -> str:
     lines += [
         f"| {c['wheels']} | {c['ms']:.1f} | {c['ms_one_start']:.1f} | {c['iterations']} | {c['converged']} |"
         for c in r["fit"]["cases"]
+    ]
+    fr = r["fit_random"]
+    lines += [
+        "",
+        f"Fit round trips on {fr['rows']} random realistic run-outs: {fr['converged']} converged, "
+        f"{fr['recovered']} recovered the generating state (reported or named as an alternative), "
+        f"{fr['other_state_unnamed']} reached the rest pose from another state without naming the "
+        f"generating one; median {fr['median_ms']:.1f} ms, max {fr['max_ms']:.1f} ms per fit.",
     ]
     return "\n".join(lines) + "\n"

@@ -16,8 +16,12 @@ weighted by load) blended toward mu as the rotation grows to 90 deg (a
 rotating vehicle slides its rolling wheels sideways).
 
 Starts: the estimate is refined by a scan of forward run-outs (speed x 0.7, 1,
-1.3; yaw rate x 1, 0.5, 0, -0.5); Newton starts from the candidate nearest the
-rest pose. Uniqueness: Newton also runs from the next two candidates; converged
+1.3; yaw rate x 1, 0.5, 0, -0.5, -1, 1.5, and +-1 rad/s when the estimate is
+below 0.5 rad/s); Newton starts from the candidate nearest the rest pose.
+Uniqueness: Newton also runs from the next three candidates whose yaw rates
+differ by more than 0.3 rad/s from those already taken (the first start that
+converges is used if the best does not; if none does, up to four further
+scanned starts are tried); converged
 states that differ from the reported one by more than 0.05 m/s or 0.02 rad/s
 are named in the warnings (the reported one is the converged state nearest the
 estimate).
@@ -39,8 +43,10 @@ HEADING_TOL = 1e-5  # rad
 DISTINCT_SPEED = 0.05  # m/s
 DISTINCT_YAW = 0.02  # rad/s
 SPEED_SCALES = (0.7, 1.0, 1.3)
-YAW_SCALES = (1.0, 0.5, 0.0, -0.5)
-UNIQUE_STARTS = 2
+YAW_SCALES = (1.0, 0.5, 0.0, -0.5, -1.0, 1.5)
+UNIQUE_STARTS = 3
+DIVERSE_YAW = 0.3  # rad/s: extra starts differ at least this much in yaw rate
+RESCUE_STARTS = 4  # further scanned starts tried when no start converged
 UNIQUE_BUDGET = 12  # run-outs per extra start
 LOOSE_TOL = 1e-5  # integrator tolerance of the scan (forward runs only)
 # Newton's first stage and the extra starts: at 1e-5 and 1e-6 the integrated
@@ -166,21 +172,42 @@ def _newton(vehicle: RunoutVehicle, start, tol, budget: int, coarse: bool = Fals
     )
 
 
+def _yaw_candidates(w: float) -> list[float]:
+    """Yaw rates to scan: the estimate times YAW_SCALES, and +-1 rad/s when the
+    estimate is small (a rest pose that barely turned may still come from a spin)."""
+    found = [w * s for s in YAW_SCALES]
+    if abs(w) < 0.5:
+        found += [1.0, -1.0]
+    return found
+
+
 def _scan(vehicle: RunoutVehicle, estimate, tol) -> list:
     """Candidate starts around the estimate, best residual first: speed x
-    SPEED_SCALES, yaw rate x YAW_SCALES, each run forward once."""
+    SPEED_SCALES, each yaw rate of `_yaw_candidates`, each run forward once."""
     cols, scale = columns(), _radius(vehicle.row)
     vx, vy, w = estimate
     x_r, y_r, psi_r = vehicle.rest
     found = []
     for sv in SPEED_SCALES:
-        for sw in YAW_SCALES:
-            p = (vx * sv, vy * sv, w * sw)
+        for yaw in _yaw_candidates(w):
+            p = (vx * sv, vy * sv, yaw)
             y, _, status, _, _ = run_row(row_values(vehicle, cols, *p), tol=tol)
             if status == 0:
                 res = math.hypot(math.hypot(y[0] - x_r, y[1] - y_r), (y[2] - psi_r) * scale)
                 found.append((res, p))
     return [p for _, p in sorted(found)]
+
+
+def _diverse(starts: list, count: int) -> list:
+    """The first `count` starts after the first whose yaw rates differ from every
+    one taken before (the first included) by more than DIVERSE_YAW."""
+    taken = starts[:1]
+    for p in starts[1:]:
+        if len(taken) > count:
+            break
+        if all(abs(p[2] - q[2]) > DIVERSE_YAW for q in taken):
+            taken.append(p)
+    return taken[1:]
 
 
 def fit_rest(vehicle: RunoutVehicle, tol: float | None = None, check_unique: bool = True) -> Fit:
@@ -191,7 +218,7 @@ def fit_rest(vehicle: RunoutVehicle, tol: float | None = None, check_unique: boo
     estimate = starting_estimate(vehicle)
     starts = _scan(vehicle, estimate, LOOSE_TOL) or [estimate]
     fits = [newton(vehicle, starts[0], tol)]
-    for start in starts[1 : 1 + UNIQUE_STARTS] if check_unique else []:
+    for start in _diverse(starts, UNIQUE_STARTS) if check_unique else []:
         fits.append(_newton(vehicle, start, NEWTON_TOL, UNIQUE_BUDGET, coarse=True))
     primary, distinct = fits[0], []
     for f in fits[1:]:
@@ -199,6 +226,11 @@ def fit_rest(vehicle: RunoutVehicle, tol: float | None = None, check_unique: boo
             distinct.append(f)
     if not primary.converged:
         if not distinct:
+            tried = [f.start for f in fits]
+            for start in [p for p in starts if p not in tried][:RESCUE_STARTS]:
+                rescue = newton(vehicle, start, tol)
+                if rescue.converged:
+                    return rescue
             return primary
         primary, distinct = distinct[0], distinct[1:]
     est = np.array(estimate)
