@@ -601,23 +601,7 @@ def _setup(v, eps):
     return P, W
 
 
-__ROW__def _batch(c, out_x_rest, out_y_rest, out_psi_rest, out_t, out_distance, out_status, out_steps, tol, eps):
-    """Rows of runout_row; c is the (rows, COLUMNS) input table."""
-    empty = np.empty((0, 4))
-    for i in prange(c.shape[0]):
-        y, t, status, steps, _ = runout_row(c[i], tol, eps, empty)
-        out_x_rest[i] = y[0]
-        out_y_rest[i] = y[1]
-        out_psi_rest[i] = y[2]
-        out_t[i] = t
-        out_distance[i] = y[6]
-        out_status[i] = status
-        out_steps[i] = steps
-
-
-runout_batch = njit(cache=True, error_model="numpy", parallel=True)(_batch)
-runout_batch_serial = njit(cache=True, error_model="numpy")(_batch)
-'''
+__ROW____BATCH__'''
 INTEGRATE_TEMPLATE = '''@__JIT__
 def _integrate__SUFFIX__(y, P, W, tol, path):
     """Adaptive Dormand-Prince 5(4) (FSAL, local extrapolation) from t = 0 until
@@ -715,6 +699,22 @@ __SINIT__    t, status, steps, points = _integrate__SUFFIX__(y, P, W, tol, path)
 
 
 '''
+BATCH_TEMPLATE = '''@__DECORATOR__
+def __NAME__(c, out_x_rest, out_y_rest, out_psi_rest, out_t, out_distance, out_status, out_steps, tol, eps):
+    """__KIND__ rows of runout_row; c is the (rows, COLUMNS) input table. (Two
+    separate functions, not one wrapped twice: numba's cache keys a compiled
+    function by its definition, so the two wrappers would share one entry.)"""
+    empty = np.empty((0, 4))
+    for i in __RANGE__(c.shape[0]):
+        y, t, status, steps, _ = runout_row(c[i], tol, eps, empty)
+        out_x_rest[i] = y[0]
+        out_y_rest[i] = y[1]
+        out_psi_rest[i] = y[2]
+        out_t[i] = t
+        out_distance[i] = y[6]
+        out_status[i] = status
+        out_steps[i] = steps
+'''
 ACC = [f"d{a}{k}" for a in "xyz" for k in range(5)]
 INTEGRATOR_SOURCE = (
     INTEGRATOR_SOURCE.replace("__JIT__", JIT)
@@ -749,6 +749,18 @@ INTEGRATOR_SOURCE = (
         .replace(
             "__SINIT__", "    y[7 + 4*3 + 0] = 1.0\n    y[7 + 4*4 + 1] = 1.0\n    y[7 + 4*5 + 2] = 1.0\n"
         ),
+    )
+    .replace(
+        "__BATCH__",
+        BATCH_TEMPLATE.replace("__DECORATOR__", 'njit(cache=True, error_model="numpy", parallel=True)')
+        .replace("__NAME__", "runout_batch")
+        .replace("__KIND__", "Parallel")
+        .replace("__RANGE__", "prange")
+        + "\n\n"
+        + BATCH_TEMPLATE.replace("__DECORATOR__", JIT)
+        .replace("__NAME__", "runout_batch_serial")
+        .replace("__KIND__", "Serial")
+        .replace("__RANGE__", "range"),
     )
     .replace("__JIT__", JIT)
 )
