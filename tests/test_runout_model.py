@@ -147,3 +147,25 @@ def test_batch_refuses_a_missing_or_unknown_column_naming_it():
     cols["muu"] = np.array([0.8])
     with pytest.raises(SceneError, match="^muu: unknown column"):
         runout_batch(cols)
+
+
+def test_extreme_rows_run_to_rest_or_get_a_status():
+    """Stress: at rest already, 60 m/s, 20 rad/s, full brake (cap 0), steer 89
+    deg, mu 2, a 5 deg slip angle, a light trailer-like body: every row either
+    stops with finite outputs, or has a status and NaN outputs; never a
+    solved row with NaN."""
+    rows = [
+        _row(1.0),  # at rest
+        _row(0.0, vx=60.0),
+        _row(1.0, w=20.0),
+        _row(0.0, vx=10.0, vy=5.0, w=3.0, mu=2.0, alpha_max=math.radians(5)),
+        _row(0.0, vx=8.0, vy=-8.0, m=300.0, I=150.0),
+    ]
+    rows.append(dict(_row(0.0, vx=12.0, w=1.0), brake_fl=1.0, brake_fr=1.0, steer_rl=math.radians(89)))
+    out = runout_batch(rows_table(rows))
+    assert (out["status"] == 0).all()
+    for key in ("x_rest", "y_rest", "psi_rest", "t", "distance"):
+        assert np.isfinite(out[key]).all(), key
+    assert out["t"][0] == 0.0 and out["x_rest"][0] == BASE["x"] and out["distance"][0] == 0.0
+    # a wheel that is fully braked pushes only along itself: the car still stops
+    assert out["distance"][5] > 0
