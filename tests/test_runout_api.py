@@ -213,3 +213,35 @@ def test_linear_separation_sensitivity_matches_a_refit():
     again = fit_rest(load_runout(moved).vehicles[0])
     predicted = np.array([*base.velocity, base.yaw_rate]) + A @ [0.05, 0.0, 0.0, 0.01]
     assert np.allclose([*again.velocity, again.yaw_rate], predicted, atol=2e-3)
+
+
+def test_fit_with_a_tyre_mark_direction_at_separation():
+    """The direction of a wheel's mark at separation enters the fit as a fourth
+    residual: consistent with the rest pose it is met and the state recovered;
+    3 deg off, the least-squares fit spreads the misfit over the mark and the
+    rest pose."""
+    scene = _scene()
+    v = scene["vehicles"][0]
+    v["wheels"] = {
+        "front_left": "locked",
+        "front_right": "locked",
+        "rear_left": "rolling",
+        "rear_right": "rolling",
+    }
+    v["separation"].update(velocity=[9.0, 2.0], yaw_rate=1.0)
+    rest = runout(scene)["vehicles"][0]["rest"]
+    psi = math.radians(30.0)
+    rx, ry = 1.1 * math.cos(psi) - 0.75 * math.sin(psi), 1.1 * math.sin(psi) + 0.75 * math.cos(psi)
+    true_mark = math.degrees(math.atan2(2.0 + 1.0 * rx, 9.0 - 1.0 * ry))
+    del v["separation"]["velocity"], v["separation"]["yaw_rate"]
+    v["rest"] = rest
+    v["separation"]["mark_directions"] = {"front_left": true_mark}
+    entry = runout(scene)["vehicles"][0]
+    assert entry["fit"]["converged"]
+    assert entry["fit"]["residual"]["marks"]["front_left"] < 1e-3
+    assert entry["separation"]["velocity"] == pytest.approx([9.0, 2.0], abs=0.01)
+    v["separation"]["mark_directions"] = {"front_left": true_mark + 3.0}
+    off = runout(scene)["vehicles"][0]
+    assert off["fit"]["converged"]
+    assert 0.01 < off["fit"]["residual"]["marks"]["front_left"] < 3.0
+    assert off["fit"]["residual"]["position"] > 1e-3

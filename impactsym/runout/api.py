@@ -73,6 +73,9 @@ def _vehicle(sc: RunoutScene, v: RunoutVehicle, index: int, path: bool, tol, war
             "heading": abs(math.degrees(y[2] - v.rest[2])),
         }
         if fit is not None:
+            if v.marks:
+                names = {"fl": "front_left", "fr": "front_right", "rl": "rear_left", "rr": "rear_right"}
+                residual["marks"] = {names[k]: abs(math.degrees(d)) for k, d in zip(v.marks, fit.marks)}
             entry["fit"] = {"residual": residual, "iterations": fit.iterations, "converged": fit.converged}
         else:
             entry["residual"] = residual

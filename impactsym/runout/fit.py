@@ -68,6 +68,9 @@ class Fit:
     converged: bool
     start: tuple[float, float, float]
     alternatives: list = field(default_factory=list)
+    marks: list = field(
+        default_factory=list
+    )  # residuals of the mark directions [rad], in vehicle.marks order
 
 
 def _wheel_table(row: dict):
@@ -112,7 +115,31 @@ def _evaluate(vehicle, cols, p, tol):
     S = y[7:].reshape(6, 4)
     J = S[:3, :3].copy()
     J[2] *= scale
+    if vehicle.marks:
+        rm, Jm = _mark_rows(vehicle, p, scale)
+        r, J = np.concatenate([r, rm]), np.vstack([J, Jm])
     return r, J
+
+
+def _mark_rows(vehicle: RunoutVehicle, p, scale: float):
+    """Residuals (wrapped angle differences times `scale`) and Jacobian rows of
+    the tyre-mark directions: a mark leaves along the wheel's contact-point
+    velocity u = v + w (-r_y, r_x) at separation, r the wheel's position from
+    the centre of gravity in the scene frame; d atan2(u_y, u_x) =
+    (u_x du_y - u_y du_x)/|u|^2."""
+    row, c, s = vehicle.row, math.cos(vehicle.heading), math.sin(vehicle.heading)
+    half, b = row["track"] / 2, row["L"] - row["a"]
+    spots = {"fl": (row["a"], half), "fr": (row["a"], -half), "rl": (-b, half), "rr": (-b, -half)}
+    vx, vy, w = p
+    res, rows = [], []
+    for key, direction in vehicle.marks.items():
+        rx = c * spots[key][0] - s * spots[key][1]
+        ry = s * spots[key][0] + c * spots[key][1]
+        ux, uy = vx - w * ry, vy + w * rx
+        u2 = max(ux * ux + uy * uy, 1e-12)
+        res.append(math.remainder(math.atan2(uy, ux) - direction, math.tau) * scale)
+        rows.append([-uy / u2 * scale, ux / u2 * scale, (ux * rx + uy * ry) / u2 * scale])
+    return np.array(res), np.array(rows)
 
 
 def _radius(row) -> float:
@@ -144,7 +171,7 @@ def _newton(vehicle: RunoutVehicle, start, tol, budget: int, coarse: bool = Fals
     cols, scale = columns(), _radius(vehicle.row)
     p = np.array(start, dtype=float)
     r, J = _evaluate(vehicle, cols, p, tol)
-    iterations, runs, lam = 0, 1, 1e-3
+    iterations, runs, lam, stalled = 0, 1, 1e-3, False
     while r is not None and not _done(r, scale, coarse) and runs < budget:
         A, g = J.T @ J, J.T @ r
         step = np.linalg.solve(A + lam * np.diag(np.diag(A) + 1e-12), -g)
@@ -152,12 +179,17 @@ def _newton(vehicle: RunoutVehicle, start, tol, budget: int, coarse: bool = Fals
         rt, Jt = _evaluate(vehicle, cols, trial, tol)
         runs += 1
         if rt is not None and float(rt @ rt) < float(r @ r):
+            settled = float(r @ r) - float(rt @ rt) < 1e-12 * float(r @ r) + 1e-24
             p, r, J = trial, rt, Jt
             lam = max(lam / 10, 1e-9)
             iterations += 1
+            if len(r) > 3 and settled:  # least squares with marks: the residual stops falling
+                stalled = True
+                break
         else:
             lam *= 10
             if lam > 1e8:
+                stalled = len(r) > 3  # no step lowers the least-squares residual: its minimum
                 break
     if r is None:
         return Fit((math.nan, math.nan), math.nan, math.inf, math.inf, iterations, False, tuple(start))
@@ -167,8 +199,9 @@ def _newton(vehicle: RunoutVehicle, start, tol, budget: int, coarse: bool = Fals
         math.hypot(r[0], r[1]),
         abs(r[2]) / scale,
         iterations,
-        bool(_done(r, scale, coarse)),
+        bool(_done(r, scale, coarse) or stalled),
         tuple(start),
+        marks=[float(x) / scale for x in r[3:]],
     )
 
 

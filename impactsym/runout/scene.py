@@ -66,7 +66,7 @@ VEHICLE_KEYS = (
 )
 WHEEL_NAMES = ("front_left", "front_right", "rear_left", "rear_right")
 WHEEL_KEYS = ("state", "brake", "steer")
-SEPARATION_KEYS = ("position", "heading", "velocity", "yaw_rate")
+SEPARATION_KEYS = ("position", "heading", "velocity", "yaw_rate", "mark_directions")
 REST_KEYS = ("position", "heading")
 
 
@@ -84,6 +84,9 @@ class RunoutVehicle:
     yaw_rate: float | None
     rest: tuple[float, float, float] | None
     wheels: dict = field(default_factory=dict)
+    marks: dict = field(
+        default_factory=dict
+    )  # wheel key (fl, fr, rl, rr) -> mark direction at separation [rad]
 
     @property
     def fitted(self) -> bool:
@@ -227,6 +230,7 @@ def _vehicle(v: Mapping, index: int, tyre: dict, centre, units: str, length: flo
     has_v, has_w = "velocity" in sep, "yaw_rate" in sep
     velocity = _pair(sep["velocity"], f"{p}.separation.velocity") if has_v else None
     yaw_rate = _number(sep["yaw_rate"], f"{p}.separation.yaw_rate") if has_w else None
+    marks = _marks(sep.get("mark_directions", {}), f"{p}.separation.mark_directions")
     rest = None
     if "rest" in v:
         r = _mapping(v["rest"], f"{p}.rest")
@@ -271,7 +275,18 @@ def _vehicle(v: Mapping, index: int, tyre: dict, centre, units: str, length: flo
         yaw_rate=yaw_rate,
         rest=rest,
         wheels=wheels,
+        marks=marks,
     )
+
+
+def _marks(value: Any, path: str) -> dict[str, float]:
+    """``mark_directions``: per wheel name, the direction [deg] in which the tyre
+    mark of that wheel leaves the separation point (the direction of the wheel's
+    contact-point velocity at separation), as wheel key -> radians."""
+    entry = _mapping(value, path)
+    check_keys(entry, WHEEL_NAMES, path)
+    keys = dict(zip(WHEEL_NAMES, ("fl", "fr", "rl", "rr")))
+    return {keys[name]: math.radians(_number(entry[name], f"{path}.{name}")) for name in entry}
 
 
 def row_values(
