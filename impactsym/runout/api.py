@@ -61,7 +61,9 @@ def _vehicle(sc: RunoutScene, v: RunoutVehicle, index: int, path: bool, tol, war
         "rotation": math.degrees(y[2] - v.heading),
         "separation": {
             "position": [v.position[0] / length, v.position[1] / length],
-            "heading": math.degrees(v.heading),
+            "heading": round(
+                math.degrees(v.heading), 12
+            ),  # the given value back, without the radian round trip
             "velocity": [vx / length, vy / length],
             "speed": math.hypot(vx, vy) / length,
             "yaw_rate": w,
