@@ -122,11 +122,15 @@ def _report(result, args: argparse.Namespace, command: str) -> int:
 
 def _run_solve(args: argparse.Namespace) -> int:
     """Solve a scene; print JSON (``--json``) or a table."""
+    if runout_cli.chained(args):  # run-out data: pre-impact -> impact -> rest
+        return runout_cli.run_chained(args, "solve")
     return _report(solve(args.scene), args, "solve")
 
 
 def _run_reconstruct(args: argparse.Namespace) -> int:
     """Reconstruct pre-impact speeds from final motion and headings; print JSON or a table."""
+    if runout_cli.chained(args):  # rest poses: fitted run-outs -> impact
+        return runout_cli.run_chained(args, "reconstruct")
     return _report(reconstruct(args.scene), args, "reconstruct")
 
 

@@ -245,3 +245,42 @@ def test_fit_with_a_tyre_mark_direction_at_separation():
     assert off["fit"]["converged"]
     assert 0.01 < off["fit"]["residual"]["marks"]["front_left"] < 3.0
     assert off["fit"]["residual"]["position"] > 1e-3
+
+
+def test_solve_and_reconstruct_commands_chain_through_the_runout():
+    """conventions.md, "Chained": a solve scene with run-out data reports each
+    vehicle's rest; a reconstruct scene with rest poses fits the run-outs first."""
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "impactsym",
+            "solve",
+            str(ROOT / "examples" / "runout" / "chain_solve.json"),
+            "--json",
+        ],
+        capture_output=True,
+        text=True,
+        env=dict(os.environ, PYTHONPATH=str(ROOT)),
+        timeout=300,
+    )
+    assert proc.returncode == 0, proc.stderr
+    solved = json.loads(proc.stdout)
+    assert all(set(v["rest"]) == {"position", "heading"} for v in solved["vehicles"])
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "impactsym",
+            "reconstruct",
+            str(ROOT / "examples" / "runout" / "chain_reconstruct.json"),
+            "--json",
+        ],
+        capture_output=True,
+        text=True,
+        env=dict(os.environ, PYTHONPATH=str(ROOT)),
+        timeout=300,
+    )
+    assert proc.returncode == 0, proc.stderr
+    speeds = [v["speed"] for v in json.loads(proc.stdout)["vehicles"]]
+    assert speeds == pytest.approx([17.0, 8.0], abs=0.01)

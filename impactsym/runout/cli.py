@@ -59,6 +59,36 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def chained(args: argparse.Namespace) -> bool:
+    """Whether the ``solve``/``reconstruct`` scene of `args` carries run-out data
+    (a top-level ``runout`` object): then `run_chained` answers the command."""
+    from ..scene import scene_data
+
+    try:
+        data = scene_data(args.scene)
+    except (OSError, ValueError):
+        return False  # the command's own reading reports it
+    return isinstance(data, dict) and "runout" in data
+
+
+def run_chained(args: argparse.Namespace, command: str) -> int:
+    """``solve``/``reconstruct`` of a scene with run-out data (conventions.md,
+    "Chained"): the command's JSON with each vehicle's run-out attached."""
+    if getattr(args, "uncertainty", None):
+        raise SceneError(
+            "not yet available through the run-out from the command line "
+            "(impactsym.runout.interval.reconstruct_interval gives the intervals)",
+            "--uncertainty",
+        )
+    if getattr(args, "plot", None):
+        raise SceneError("draw a chained scene's run-outs with impactsym runout SCENE --plot", "--plot")
+    from .chain import reconstruct_from_rest, solve_to_rest
+
+    result = (solve_to_rest if command == "solve" else reconstruct_from_rest)(args.scene)
+    print(json.dumps(json_clean(result), indent=2) if args.json else _chain_table(result))
+    return 0
+
+
 def _run_chain(args: argparse.Namespace) -> int:
     """``--chain``: the impact command's JSON with the run-outs attached."""
     from .chain import reconstruct_from_rest, solve_to_rest
