@@ -186,6 +186,54 @@ def _fit_random(n: int) -> dict:
     return counts
 
 
+def _closed_forms() -> list[dict]:
+    """The closed-form cases of tests/test_runout_model.py, with their errors."""
+    from tests.test_runout_model import BASE, G, _one, _row
+
+    psi, out = BASE["psi"], []
+    for v in (5.0, 20.0, 35.0):
+        y = _one(_row(1.0, vx=v * math.cos(psi), vy=v * math.sin(psi)))[0]
+        got, exp = math.hypot(y[0] - 1.0, y[1] + 2.0), v * v / (2 * 0.8 * G)
+        out.append({"case": f"locked slide from {v:g} m/s", "run_out": got, "closed_form": exp, "unit": "m"})
+    for w in (-4.0, 1.5, 6.0):
+        y = _one(_row(1.0, a=1.35, w=w))[0]
+        exp = 2400.0 * w * w / (2 * 0.8 * 1450.0 * G * math.hypot(1.35, 0.75))
+        out.append(
+            {
+                "case": f"locked spin from {w:g} rad/s",
+                "run_out": abs(y[2] - psi),
+                "closed_form": exp,
+                "unit": "rad",
+            }
+        )
+    for v in (3.0, 10.0):
+        y = _one(_row(0.0, vx=v * math.cos(psi), vy=v * math.sin(psi)))[0]
+        got, exp = math.hypot(y[0] - 1.0, y[1] + 2.0), v * v / (2 * 0.01 * G)
+        out.append(
+            {"case": f"rolling resistance from {v:g} m/s", "run_out": got, "closed_form": exp, "unit": "m"}
+        )
+    return out
+
+
+def _reference_check() -> dict:
+    """The rows of tests/test_runout_reference.py: worst rest errors against DOP853 rtol 1e-10."""
+    from impactsym.runout import runout_batch
+    from impactsym.testing.runout_reference import reference_runout
+    from tests.runout_rows import realistic_row, rows_table
+
+    rng = np.random.default_rng(2024)
+    rows = [realistic_row(rng) for _ in range(10)]
+    out = runout_batch(rows_table(rows))
+    worst = {"position_m": 0.0, "heading_deg": 0.0, "share_of_allowance": 0.0}
+    for i, row in enumerate(rows):
+        x, y, psi, _, dist = reference_runout(row)
+        err = math.hypot(out["x_rest"][i] - x, out["y_rest"][i] - y)
+        worst["position_m"] = max(worst["position_m"], err)
+        worst["heading_deg"] = max(worst["heading_deg"], abs(math.degrees(out["psi_rest"][i] - psi)))
+        worst["share_of_allowance"] = max(worst["share_of_allowance"], err / (1e-3 + 1e-5 * dist))
+    return worst
+
+
 def _columns():
     from impactsym.runout.batch import columns
 
@@ -219,6 +267,8 @@ def main(args: argparse.Namespace) -> int:
         "runouts_per_second_one_thread_default_tol": 1.0 / default["seconds_per_runout"],
         "fit": _fit_timing(),
         "fit_random": _fit_random(args.fits),
+        "closed_forms": _closed_forms(),
+        "reference_10_rows": _reference_check(),
     }
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "runout.json").write_text(json.dumps(result, indent=1))
@@ -287,6 +337,23 @@ def _markdown(r: dict) -> str:
     lines += [
         f"| {c['wheels']} | {c['ms']:.1f} | {c['ms_one_start']:.1f} | {c['iterations']} | {c['converged']} |"
         for c in r["fit"]["cases"]
+    ]
+    lines += [
+        "",
+        "| closed form (tests/test_runout_model.py) | run-out | closed form | error |",
+        "|---|---|---|---|",
+    ]
+    lines += [
+        f"| {c['case']} | {c['run_out']:.7g} {c['unit']} | {c['closed_form']:.7g} {c['unit']} | "
+        f"{c['run_out'] - c['closed_form']:.1e} {c['unit']} |"
+        for c in r["closed_forms"]
+    ]
+    ref = r["reference_10_rows"]
+    lines += [
+        "",
+        f"Against solve_ivp DOP853 rtol 1e-10 on the 10 rows of tests/test_runout_reference.py: worst "
+        f"rest-position error {ref['position_m']:.2e} m, heading {ref['heading_deg']:.1e} deg, "
+        f"{100 * ref['share_of_allowance']:.1f} % of the allowance 1 mm + 1e-5 of the path.",
     ]
     fr = r["fit_random"]
     lines += [
