@@ -19,6 +19,7 @@ SUBCOMMANDS = {
     "performance": "benchmarks.performance",
     "uncertainty": "benchmarks.uncertainty",
     "trig": "benchmarks.trig",
+    "runout": "benchmarks.runout",
 }
 
 

@@ -12,7 +12,10 @@ kernel's row in generated/registry.py: family (Kernel.family, default its
 name), variant (Kernel.variant), module, driver columns, inputs, outputs,
 constants, tier, operations; a module's DATA is published there too. The
 runtime finds kernels only through that registry (impactsym/_kernels/), so
-nothing else has to be written for a batch or a single scene to run them.
+nothing else has to be written for a batch or a single scene to run them. A
+family whose kernel is a loop rather than straight-line code (the run-out's
+integrator) is listed in RENDERED_MODULES instead: its module's render(digest)
+writes its files, and its room reaches them by module through the registry.
 
 Emission always runs every proof first and stops at the first failure.
 `--check` re-renders in memory, compares bytes with generated/ and prints a
@@ -48,6 +51,8 @@ PROOF_ONLY_MODULES = ("trig",)
 # 100-300 outputs of a Jacobian does not compile (numba has no LIST_TO_TUPLE,
 # which CPython uses for tuples of more than 30 values).
 PER_SCENE_ONLY_MODULES = ("jacobian", "evidence")
+# Families that write their own files (a loop, not straight-line kernels): render(digest) -> {name: text}.
+RENDERED_MODULES = ("runout",)
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -81,8 +86,10 @@ def render_all() -> dict[str, str]:
         if drivers:
             files[f"{name}_jit.py"] = emit.render_jit_module(f"{name}.py", kernels, digest)
         listed.append((name, kernels, data, drivers))
+    for name in RENDERED_MODULES:
+        files.update(importlib.import_module(f"derive.{name}").render(digest))
     files["registry.py"] = emit.render_registry(listed, digest, REQUEST_TIERS)
-    files["__init__.py"] = emit.render_init(MODEL_MODULES, digest)
+    files["__init__.py"] = emit.render_init(MODEL_MODULES + RENDERED_MODULES, digest)
     return files
 
 
@@ -91,7 +98,7 @@ def run_proofs() -> bool:
     import importlib
 
     ok = True
-    for name in MODEL_MODULES + PROOF_ONLY_MODULES:
+    for name in MODEL_MODULES + PROOF_ONLY_MODULES + RENDERED_MODULES:
         for claim, passed in importlib.import_module(f"derive.{name}").proofs():
             print(f"  [{'ok' if passed else 'FAILED'}] {claim}")
             ok = ok and bool(passed)

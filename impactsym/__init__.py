@@ -28,6 +28,7 @@ from .explore import explore
 from .inverse import invert, invert_batch
 from .reconstruct import reconstruct, reconstruct_batch
 from .result import Result
+from .runout import runout, runout_batch
 from .scene import MODELS, Impact, Scene, SceneError, Vehicle, load_scene
 from .single import solve
 from .uncertainty import uncertainty
@@ -56,6 +57,8 @@ __all__ = [
     "plot",
     "reconstruct",
     "reconstruct_batch",
+    "runout",
+    "runout_batch",
     "sample",
     "solve",
     "solve_batch",

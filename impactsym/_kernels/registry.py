@@ -43,8 +43,12 @@ CODES = SimpleNamespace(
 
 
 @cache
-def _module(name: str):
-    """generated/<name>.py (plain Python), or with `_jit` its numba drivers."""
+def module(name: str):
+    """generated/<name>.py (plain Python), or with `_jit` its numba drivers.
+
+    Families that emit a loop rather than straight-line kernels (the run-out's
+    integrator) are reached by module through here: their rooms take their
+    columns, outputs and codes from that module's plain half."""
     if name.endswith("_jit"):
         _set_numba_cache_dir()
     return importlib.import_module(f"{generated.__name__}.{name}")
@@ -88,17 +92,17 @@ class KernelSet:
     @property
     def scene(self):
         """The per-scene function (plain Python)."""
-        return getattr(_module(self.module), self.name)
+        return getattr(module(self.module), self.name)
 
     @property
     def unit_normal(self):
         """(nx, ny) of an angle [rad], as the kernels take it; None without an angle."""
-        return _module(self.module).unit_normal if self.angle else None
+        return module(self.module).unit_normal if self.angle else None
 
     @property
     def driver(self):
         """The numba batch driver (imports numba and the module's drivers)."""
-        return getattr(_module(f"{self.module}_jit"), f"{self.name}_batch")
+        return getattr(module(f"{self.module}_jit"), f"{self.name}_batch")
 
 
 @cache

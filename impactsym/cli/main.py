@@ -12,6 +12,7 @@ from contextlib import suppress
 
 from .._version import __version__
 from ..evidence import cli as evidence_cli
+from ..runout import cli as runout_cli
 from ..scene import SceneError
 from .common import EXIT_INTERRUPTED, EXIT_TERMINATED, PROG, Command, UsageError, _fail, _Parser
 from .scene_commands import (
@@ -77,6 +78,7 @@ COMMANDS: dict[str, Command] = {
     ),
 }
 COMMANDS.update({name: Command(*spec) for name, spec in evidence_cli.COMMANDS.items()})
+COMMANDS["runout"] = Command(runout_cli.HELP, runout_cli.add_arguments, runout_cli.run)
 
 
 def build_parser() -> argparse.ArgumentParser:

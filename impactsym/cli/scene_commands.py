@@ -11,6 +11,7 @@ from ..inverse import invert
 from ..plot import add_plot_argument, save_plot
 from ..reconstruct import reconstruct
 from ..result import json_clean
+from ..runout import cli as runout_cli
 from ..single import solve
 from ..uncertainty import cli as uncertainty_cli
 from .common import UsageError, _add_scene
@@ -45,11 +46,15 @@ def _report(result, args: argparse.Namespace, command: str) -> int:
 
 def _run_solve(args: argparse.Namespace) -> int:
     """Solve a scene; print JSON (``--json``) or a table."""
+    if runout_cli.chained(args):  # run-out data: pre-impact -> impact -> rest
+        return runout_cli.run_chained(args, "solve")
     return _report(solve(args.scene), args, "solve")
 
 
 def _run_reconstruct(args: argparse.Namespace) -> int:
     """Reconstruct pre-impact speeds from final motion and headings; print JSON or a table."""
+    if runout_cli.chained(args):  # rest poses: fitted run-outs -> impact
+        return runout_cli.run_chained(args, "reconstruct")
     return _report(reconstruct(args.scene), args, "reconstruct")
 
 

@@ -1,0 +1,366 @@
+"""Run-out: run time against rest-pose error, kernels against scipy's solve_ivp.
+
+Truth: solve_ivp DOP853 at rtol 1e-10, atol 1e-12 on the contract's equations
+(impactsym/testing/runout_reference.py, written independently of derive/). The
+kernel's batch driver (one thread) at several tolerances and solve_ivp RK45 at
+several rtol (the user's alternative) run the same random realistic run-outs
+(tests/runout_rows.py); the error of a row is the distance of its rest
+position from the truth's. Also: run-outs per second of the parallel batch,
+and the fit to rest per vehicle after first use.
+
+    python -m benchmarks runout [--rows 6] [--out benchmarks/results]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+DESCRIPTION = (
+    "run-out: run time against rest-pose error, batch kernels vs scipy solve_ivp; fit to rest timing"
+)
+KERNEL_TOLS = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
+IVP_RTOLS = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
+REPEATS = 5  # timings are the best of REPEATS (the machine is shared)
+TIMING_COPIES = 20  # the timed batch repeats the compared rows this many times
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--rows", type=int, default=6, help="run-outs compared with the reference (default 6)"
+    )
+    parser.add_argument("--batch", type=int, default=2000, help="rows of the throughput batch (default 2000)")
+    parser.add_argument("--fits", type=int, default=20, help="random fit round trips (default 20)")
+    parser.add_argument(
+        "--out", type=Path, default=Path("benchmarks/results"), help="folder for runout.md/.png/.json"
+    )
+
+
+def _errors(rows, xs, ys, truth) -> np.ndarray:
+    return np.array([math.hypot(xs[i] - truth[i][0], ys[i] - truth[i][1]) for i in range(len(rows))])
+
+
+def _kernel_curve(rows, truth):
+    """Per tolerance: seconds per run-out (one thread, best of REPEATS over a
+    batch of TIMING_COPIES copies of the rows) and the worst rest error."""
+    from impactsym.runout import runout_batch
+    from tests.runout_rows import rows_table
+
+    table = rows_table(rows)
+    timed = {key: np.tile(value, TIMING_COPIES) for key, value in table.items()}
+    runout_batch(table, parallel=False)  # compile / load
+    curve = []
+    for tol in KERNEL_TOLS:
+        best = math.inf
+        for _ in range(REPEATS):
+            start = time.perf_counter()
+            runout_batch(timed, tol=tol, parallel=False)
+            best = min(best, time.perf_counter() - start)
+        out = runout_batch(table, tol=tol, parallel=False)
+        err = _errors(rows, out["x_rest"], out["y_rest"], truth)
+        curve.append(
+            {
+                "tol": tol,
+                "seconds_per_runout": best / (len(rows) * TIMING_COPIES),
+                "worst_error_m": float(err.max()),
+                "mean_steps": float(out["steps"].mean()),
+            }
+        )
+    return curve
+
+
+def _ivp_curve(rows, truth):
+    from impactsym.testing.runout_reference import reference_runout
+
+    curve = []
+    for rtol in IVP_RTOLS:
+        start = time.perf_counter()
+        res = [reference_runout(r, rtol=rtol, atol=rtol * 1e-2, method="RK45") for r in rows]
+        elapsed = time.perf_counter() - start
+        err = _errors(rows, [r[0] for r in res], [r[1] for r in res], truth)
+        curve.append(
+            {"rtol": rtol, "seconds_per_runout": elapsed / len(rows), "worst_error_m": float(err.max())}
+        )
+    return curve
+
+
+def _at_error(curve, error: float) -> float:
+    """Seconds per run-out of the cheapest point of `curve` at least as accurate as `error`."""
+    ok = [p["seconds_per_runout"] for p in curve if p["worst_error_m"] <= error]
+    return min(ok) if ok else math.nan
+
+
+def _throughput(n: int) -> float:
+    from impactsym.runout import runout_batch
+    from tests.runout_rows import realistic_row, rows_table
+
+    rng = np.random.default_rng(11)
+    table = rows_table([realistic_row(rng) for _ in range(n)])
+    runout_batch(table)
+    start = time.perf_counter()
+    out = runout_batch(table)
+    elapsed = time.perf_counter() - start
+    assert (out["status"] == 0).all()
+    return n / elapsed
+
+
+def _fit_timing() -> dict:
+    from impactsym.runout import load_runout, runout
+    from impactsym.runout.fit import fit_rest
+
+    scene = json.loads(Path("examples/runout/sedan.json").read_text())
+    cases = []
+    for wheels in (
+        "locked",
+        {"front_left": "locked", "front_right": "locked", "rear_left": "rolling", "rear_right": "rolling"},
+        scene["vehicles"][0]["wheels"],
+    ):
+        s = json.loads(json.dumps(scene))
+        s["vehicles"][0]["wheels"] = wheels
+        rest = runout(s)["vehicles"][0]["rest"]
+        del s["vehicles"][0]["separation"]["velocity"], s["vehicles"][0]["separation"]["yaw_rate"]
+        s["vehicles"][0]["rest"] = rest
+        veh = load_runout(s).vehicles[0]
+        fit_rest(veh)  # first use
+        best = math.inf
+        for _ in range(3):
+            start = time.perf_counter()
+            fit = fit_rest(veh)
+            best = min(best, time.perf_counter() - start)
+        single = math.inf
+        for _ in range(3):
+            start = time.perf_counter()
+            fit_rest(veh, check_unique=False)
+            single = min(single, time.perf_counter() - start)
+        cases.append(
+            {
+                "wheels": str(wheels)[:60],
+                "ms": best * 1e3,
+                "ms_one_start": single * 1e3,
+                "iterations": fit.iterations,
+                "converged": fit.converged,
+                "velocity": fit.velocity,
+                "yaw_rate": fit.yaw_rate,
+            }
+        )
+    return {"cases": cases}
+
+
+def _fit_random(n: int) -> dict:
+    """Round trips on random realistic run-outs: forward, then fitted to the rest
+    pose reached. Counts fits that converged, that recovered the generating
+    state (0.01 m/s, 0.01 rad/s; the reported state or a named alternative),
+    and that reached the rest pose from another state without naming it."""
+    from impactsym.runout.batch import run_row
+    from impactsym.runout.fit import fit_rest
+    from impactsym.runout.scene import RunoutVehicle
+    from tests.runout_rows import realistic_row
+
+    rng = np.random.default_rng(5)
+    counts = {"rows": n, "converged": 0, "recovered": 0, "other_state_unnamed": 0}
+    times = []
+    for _ in range(n):
+        row = realistic_row(rng)
+        y, _, _, _, _ = run_row(np.array([row[c] for c in _columns()]))
+        fixed = {k: v for k, v in row.items() if k not in ("vx", "vy", "w")}
+        veh = RunoutVehicle("r", fixed, (row["x"], row["y"]), row["psi"], None, None, (y[0], y[1], y[2]))
+        start = time.perf_counter()
+        fit = fit_rest(veh)
+        times.append(time.perf_counter() - start)
+        found = [fit, *fit.alternatives]
+        hit = any(
+            math.hypot(f.velocity[0] - row["vx"], f.velocity[1] - row["vy"]) < 0.01
+            and abs(f.yaw_rate - row["w"]) < 0.01
+            for f in found
+        )
+        counts["converged"] += fit.converged
+        counts["recovered"] += fit.converged and hit
+        counts["other_state_unnamed"] += fit.converged and not hit
+    counts["median_ms"] = float(np.median(times) * 1e3)
+    counts["max_ms"] = float(np.max(times) * 1e3)
+    return counts
+
+
+def _closed_forms() -> list[dict]:
+    """The closed-form cases of tests/test_runout_model.py, with their errors."""
+    from tests.test_runout_model import BASE, G, _one, _row
+
+    psi, out = BASE["psi"], []
+    for v in (5.0, 20.0, 35.0):
+        y = _one(_row(1.0, vx=v * math.cos(psi), vy=v * math.sin(psi)))[0]
+        got, exp = math.hypot(y[0] - 1.0, y[1] + 2.0), v * v / (2 * 0.8 * G)
+        out.append({"case": f"locked slide from {v:g} m/s", "run_out": got, "closed_form": exp, "unit": "m"})
+    for w in (-4.0, 1.5, 6.0):
+        y = _one(_row(1.0, a=1.35, w=w))[0]
+        exp = 2400.0 * w * w / (2 * 0.8 * 1450.0 * G * math.hypot(1.35, 0.75))
+        out.append(
+            {
+                "case": f"locked spin from {w:g} rad/s",
+                "run_out": abs(y[2] - psi),
+                "closed_form": exp,
+                "unit": "rad",
+            }
+        )
+    for v in (3.0, 10.0):
+        y = _one(_row(0.0, vx=v * math.cos(psi), vy=v * math.sin(psi)))[0]
+        got, exp = math.hypot(y[0] - 1.0, y[1] + 2.0), v * v / (2 * 0.01 * G)
+        out.append(
+            {"case": f"rolling resistance from {v:g} m/s", "run_out": got, "closed_form": exp, "unit": "m"}
+        )
+    return out
+
+
+def _reference_check() -> dict:
+    """The rows of tests/test_runout_reference.py: worst rest errors against DOP853 rtol 1e-10."""
+    from impactsym.runout import runout_batch
+    from impactsym.testing.runout_reference import reference_runout
+    from tests.runout_rows import realistic_row, rows_table
+
+    rng = np.random.default_rng(2024)
+    rows = [realistic_row(rng) for _ in range(10)]
+    out = runout_batch(rows_table(rows))
+    worst = {"position_m": 0.0, "heading_deg": 0.0, "share_of_allowance": 0.0}
+    for i, row in enumerate(rows):
+        x, y, psi, _, dist = reference_runout(row)
+        err = math.hypot(out["x_rest"][i] - x, out["y_rest"][i] - y)
+        worst["position_m"] = max(worst["position_m"], err)
+        worst["heading_deg"] = max(worst["heading_deg"], abs(math.degrees(out["psi_rest"][i] - psi)))
+        worst["share_of_allowance"] = max(worst["share_of_allowance"], err / (1e-3 + 1e-5 * dist))
+    return worst
+
+
+def _columns():
+    from impactsym.runout.batch import columns
+
+    return columns()
+
+
+def main(args: argparse.Namespace) -> int:
+    from impactsym.testing.runout_reference import reference_runout
+    from tests.runout_rows import realistic_row
+
+    rng = np.random.default_rng(2024)
+    rows = [realistic_row(rng) for _ in range(args.rows)]
+    start = time.perf_counter()
+    truth = [reference_runout(r) for r in rows]
+    truth_seconds = (time.perf_counter() - start) / len(rows)
+    kernel, ivp = _kernel_curve(rows, truth), _ivp_curve(rows, truth)
+    default = next(p for p in kernel if p["tol"] == 1e-8)
+    ratios = []
+    for p in kernel:
+        ivp_s = _at_error(ivp, p["worst_error_m"])
+        ratios.append(
+            {"tol": p["tol"], "error": p["worst_error_m"], "ratio": ivp_s / p["seconds_per_runout"]}
+        )
+    result = {
+        "rows": len(rows),
+        "truth_seconds_per_runout": truth_seconds,
+        "kernel": kernel,
+        "solve_ivp_RK45": ivp,
+        "ratios_at_equal_error": ratios,
+        "runouts_per_second_parallel": _throughput(args.batch),
+        "runouts_per_second_one_thread_default_tol": 1.0 / default["seconds_per_runout"],
+        "fit": _fit_timing(),
+        "fit_random": _fit_random(args.fits),
+        "closed_forms": _closed_forms(),
+        "reference_10_rows": _reference_check(),
+    }
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "runout.json").write_text(json.dumps(result, indent=1))
+    _chart(kernel, ivp, args.out / "runout.png")
+    (args.out / "runout.md").write_text(_markdown(result))
+    print(_markdown(result))
+    return 0
+
+
+def _chart(kernel, ivp, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    ax.loglog(
+        [p["worst_error_m"] for p in kernel],
+        [p["seconds_per_runout"] for p in kernel],
+        "o-",
+        label="impactsym batch kernel (DP5(4), one thread), tol 1e-4..1e-10",
+    )
+    ax.loglog(
+        [p["worst_error_m"] for p in ivp],
+        [p["seconds_per_runout"] for p in ivp],
+        "s-",
+        label="scipy solve_ivp RK45, rtol 1e-3..1e-8",
+    )
+    ax.axvline(1e-3, color="0.5", ls=":", lw=1)
+    ax.set_xlabel("worst rest-position error against DOP853 rtol 1e-10 [m]")
+    ax.set_ylabel("run time per run-out [s]")
+    ax.legend(fontsize=8)
+    ax.grid(True, which="both", alpha=0.3)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+
+
+def _markdown(r: dict) -> str:
+    lines = [
+        "# Run-out benchmark (`python -m benchmarks runout`)",
+        "",
+        f"{r['rows']} random realistic run-outs; truth: solve_ivp DOP853 rtol 1e-10 "
+        f"({r['truth_seconds_per_runout']:.2f} s per run-out).",
+        "",
+        "| kernel tol | s per run-out (1 thread) | worst rest error [m] | mean steps | solve_ivp RK45 at equal error / kernel |",
+        "|---|---|---|---|---|",
+    ]
+    for p, q in zip(r["kernel"], r["ratios_at_equal_error"]):
+        lines.append(
+            f"| {p['tol']:.0e} | {p['seconds_per_runout']:.2e} | {p['worst_error_m']:.2e} | "
+            f"{p['mean_steps']:.0f} | {q['ratio']:.0f} |"
+        )
+    lines += ["", "| solve_ivp RK45 rtol | s per run-out | worst rest error [m] |", "|---|---|---|"]
+    lines += [
+        f"| {p['rtol']:.0e} | {p['seconds_per_runout']:.2e} | {p['worst_error_m']:.2e} |"
+        for p in r["solve_ivp_RK45"]
+    ]
+    lines += [
+        "",
+        f"Parallel batch (default tol 1e-8): {r['runouts_per_second_parallel']:.0f} run-outs/s; "
+        f"one thread: {r['runouts_per_second_one_thread_default_tol']:.0f} run-outs/s.",
+        "",
+        "| fit to rest (after first use) | ms (scan + 3 Newton starts, fit.py) | ms (one start) | iterations | converged |",
+        "|---|---|---|---|---|",
+    ]
+    lines += [
+        f"| {c['wheels']} | {c['ms']:.1f} | {c['ms_one_start']:.1f} | {c['iterations']} | {c['converged']} |"
+        for c in r["fit"]["cases"]
+    ]
+    lines += [
+        "",
+        "| closed form (tests/test_runout_model.py) | run-out | closed form | error |",
+        "|---|---|---|---|",
+    ]
+    lines += [
+        f"| {c['case']} | {c['run_out']:.7g} {c['unit']} | {c['closed_form']:.7g} {c['unit']} | "
+        f"{c['run_out'] - c['closed_form']:.1e} {c['unit']} |"
+        for c in r["closed_forms"]
+    ]
+    ref = r["reference_10_rows"]
+    lines += [
+        "",
+        f"Against solve_ivp DOP853 rtol 1e-10 on the 10 rows of tests/test_runout_reference.py: worst "
+        f"rest-position error {ref['position_m']:.2e} m, heading {ref['heading_deg']:.1e} deg, "
+        f"{100 * ref['share_of_allowance']:.1f} % of the allowance 1 mm + 1e-5 of the path.",
+    ]
+    fr = r["fit_random"]
+    lines += [
+        "",
+        f"Fit round trips on {fr['rows']} random realistic run-outs: {fr['converged']} converged, "
+        f"{fr['recovered']} recovered the generating state (reported or named as an alternative), "
+        f"{fr['other_state_unnamed']} reached the rest pose from another state without naming the "
+        f"generating one; median {fr['median_ms']:.1f} ms, max {fr['max_ms']:.1f} ms per fit.",
+    ]
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,769 @@
+"""Post-impact run-out: a planar 3-DOF vehicle on four tyres, from separation to rest.
+
+The model is conventions.md, "Post-impact run-out" (Steffan & Moser, SAE 960886,
+planar form). State (scene frame, SI): x, y, psi, vx, vy, w. A wheel k sits at
+(px, py) in the vehicle frame (x forward, y left), steered by delta; its contact
+point moves at u = v + w·(-ry, rx); u_l is the component of u along the wheel
+(axis at psi + delta) and u_s across it. With the static normal load N:
+
+* locked wheel:  F = -mu N u/|u|;
+* rolling wheel: F_l = -(b mu + f) N sgn(u_l), f = f_r when b = 0 (plain
+  rolling: rolling resistance) and 0 when b > 0 (braked: the brake instead);
+  F_s = -mu N sgn(u_s) min(alpha/alpha_max, cap), alpha = atan(|u_s|/|u_l|),
+  cap = sqrt(1 - b^2) (1 for b = 0: the contract's lateral law; the braked
+  wheel's lateral force capped at sqrt(1 - b^2) mu N).
+
+m dv/dt = sum F, I dw/dt = sum r x F.
+
+Smoothing near zero speed (the contract leaves it to the implementation): every
+speed that divides or gives a sign enters as max(|u|, eps), eps = EPS = 0.5 mm/s
+(``Modulus``): sgn(u) becomes u/max(|u|, eps), u/|u| becomes u/max(|u|, eps),
+and alpha·sgn(u_s) becomes atan2(u_s, max(|u_l|, eps)). Above eps every force
+is the contract's exactly (a smooth u/sqrt(u^2 + eps^2) was tried first: its
+relative deviation eps^2/(2u^2) reaches far above eps and moved a rolling
+run-out from 20 m/s by 1.2 mm at eps = 5 mm/s); below eps the forces fade
+linearly with speed, so the equations are Lipschitz (an explicit RK
+integrates them). Two effects move the rest pose, both measured (eps against
+eps/10 on random realistic run-outs, tests/test_runout_model.py; at eps = 5
+mm/s the second one reached 2.0 mm and 0.03 deg, hence 0.5 mm/s): the creep
+below eps, eps^2/(2a) (a the deceleration; 1e-6 m even for rolling
+resistance alone), and the creep of a wheel that sticks (a braked or
+rolling wheel whose sgn(u_l) holds against the other forces, as static
+friction would): its u_l settles at a share of eps instead of 0, so the
+vehicle creeps by a distance proportional to eps for as long as it sticks
+(0.3 mm and 0.005 deg worst measured). The run-out ends when
+|v| + |w| R_max < V_STOP = 1 mm/s (R_max the farthest wheel from the centre
+of gravity): above eps the forces are the sharp ones, so the remaining travel
+is at most V_STOP^2/(2 f_r g) = 5 um.
+
+Emitted (``render``): generated/runout.py (plain: the constants, columns and
+status codes) and generated/runout_jit.py (numba: the wheel forces and their
+Jacobians with respect to (psi, vx, vy, w, mu), the right-hand side with its
+sensitivity equations, and the adaptive Dormand-Prince 5(4) integrator with its
+batch drivers; all in one file because numba's cache does not notice a change
+of a jitted callee in another file).
+"""
+
+from __future__ import annotations
+
+import random
+
+import mpmath
+import sympy as sp
+
+from . import emit
+
+EPS = 0.0005  # m/s, smoothing speed of sgn and |.| (see the module docstring)
+V_STOP = 1e-3  # m/s, |v| + |w| R_max below which the vehicle is at rest
+T_MAX = 600.0  # s, a run-out still moving after this is reported NOT_STOPPED
+MAX_STEPS = 200_000  # accepted plus rejected steps per row
+TOL = 1e-8  # default local error tolerance per step (m, rad, m/s, rad/s; absolute)
+H0 = 1e-3  # s, first trial step
+H_MAX = 0.25  # s, longest step (keeps the path output legible)
+
+# Row status codes of runout_batch (0 solved). 1 and 2 mean what they mean in
+# solve_batch (derive/codes.py); 20-23 are the run-out's own.
+STATUS = {
+    "OK": 0,
+    "NONFINITE_INPUT": 1,
+    "BAD_MASS": 2,
+    "RUNOUT_BAD_GEOMETRY": 20,
+    "RUNOUT_BAD_TYRE": 21,
+    "RUNOUT_NOT_STOPPED": 22,
+    "RUNOUT_BAD_WHEEL": 23,
+}
+STATUS_TEXT = {
+    1: "a non-finite input",
+    2: "mass or yaw inertia not > 0",
+    20: "wheelbase, cg_to_front_axle or track out of range (need 0 < a < L, track > 0)",
+    21: "friction, slip_angle_max, rolling_resistance or gravity out of range",
+    22: "still moving at the time limit (no resisting force?)",
+    23: "a wheel state not 0/1, brake not in [0, 1] or steer not in (-90, 90) deg",
+}
+
+WHEELS = ("fl", "fr", "rl", "rr")
+COLUMNS = (
+    "m",
+    "I",
+    "L",
+    "a",
+    "track",
+    "mu",
+    "alpha_max",
+    "f_r",
+    "g",
+    "x",
+    "y",
+    "psi",
+    "vx",
+    "vy",
+    "w",
+) + tuple(f"{kind}_{k}" for k in WHEELS for kind in ("state", "brake", "steer"))
+OUTPUTS = ("x_rest", "y_rest", "psi_rest", "t", "distance", "status", "steps")
+# Sensitivity columns: d(x_rest, y_rest, psi_rest)/d(vx, vy, w, mu) at separation.
+SENSITIVITIES = tuple(f"d{o}_d{p}" for o in ("x", "y", "psi") for p in ("vx", "vy", "w", "mu"))
+
+# --- the model -----------------------------------------------------------------
+
+psi, vx, vy, w = sp.symbols("psi vx vy w", real=True)
+px, py, cd, sd = sp.symbols("px py cd sd", real=True)
+N, mu, amax, b, fre, cap, eps = sp.symbols("N mu amax b fre cap eps", positive=True)
+c, s = sp.symbols("c s", real=True)  # cos psi, sin psi in the emitted code
+Z = (psi, vx, vy, w, mu)  # what the wheel Jacobians differentiate with respect to
+
+
+class Clip(sp.Function):
+    """clip(z, -cap, cap): the saturated share min(alpha/alpha_max, cap) with its sign."""
+
+    def fdiff(self, argindex=1):
+        z, k = self.args
+        if argindex == 1:
+            return ClipSlope(z, k)
+        return sp.sign(z) * (1 - ClipSlope(z, k))
+
+
+class ClipSlope(sp.Function):
+    """d clip(z, -cap, cap)/dz: 1 inside (-cap, cap), 0 outside."""
+
+    def fdiff(self, argindex=1):
+        return sp.S.Zero
+
+
+def contact_velocity():
+    """(u_x, u_y) of the contact point in the vehicle frame, and (u_l, u_s) in the
+    wheel frame, as functions of psi, vx, vy, w."""
+    vbx = sp.cos(psi) * vx + sp.sin(psi) * vy
+    vby = -sp.sin(psi) * vx + sp.cos(psi) * vy
+    ux, uy = vbx - w * py, vby + w * px
+    return (ux, uy), (cd * ux + sd * uy, -sd * ux + cd * uy)
+
+
+class Modulus(sp.Function):
+    """Modulus(eps, u1, ...) = max(|(u1, ...)|, eps): a speed that never falls
+    below the smoothing speed eps (the sharp modulus above it)."""
+
+    def fdiff(self, argindex=1):
+        if argindex == 1:
+            return 1 - ModulusStep(*self.args)
+        return ModulusStep(*self.args) * self.args[argindex - 1] / self
+
+
+class ModulusStep(sp.Function):
+    """1 where |(u1, ...)| > eps (Modulus follows the speed), 0 where it is eps."""
+
+    def fdiff(self, argindex=1):
+        return sp.S.Zero
+
+
+def wheel_frame_forces(locked: bool):
+    """(F_l, F_s): the tyre force in the wheel frame (contract formulas; a
+    speed u in a sign or a denominator enters as Modulus(eps, u) = max(|u|, eps))."""
+    _, (ul, us) = contact_velocity()
+    if locked:
+        h = Modulus(eps, ul, us)
+        return -mu * N * ul / h, -mu * N * us / h
+    hl = Modulus(eps, ul)
+    return -(b * mu + fre) * N * ul / hl, -mu * N * Clip(sp.atan2(us, hl) / amax, cap)
+
+
+def chassis(fl, fs):
+    """(Fx, Fy, Mz) of a wheel-frame force (F_l, F_s): rotated by delta into the
+    vehicle frame, its moment about the centre of gravity, then rotated by psi
+    into the scene frame."""
+    fbx, fby = cd * fl - sd * fs, sd * fl + cd * fs
+    return sp.cos(psi) * fbx - sp.sin(psi) * fby, sp.sin(psi) * fbx + sp.cos(psi) * fby, px * fby - py * fbx
+
+
+def scene_forces(locked: bool):
+    """(Fx, Fy, Mz): the wheel's force in the scene frame and its moment about
+    the centre of gravity."""
+    return chassis(*wheel_frame_forces(locked))
+
+
+def _to_cs(expr):
+    return expr.xreplace({sp.cos(psi): c, sp.sin(psi): s})
+
+
+def wheel_outputs(locked: bool, jacobian: bool):
+    """The emitted outputs: (Fx, Fy, Mz), then with `jacobian` their derivatives
+    with respect to Z = (psi, vx, vy, w, mu), row by row."""
+    forces = scene_forces(locked)
+    outs = list(forces)
+    if jacobian:
+        outs += [sp.diff(f, z) for f in forces for z in Z]
+    return [_to_cs(o) for o in outs]
+
+
+WHEEL_ARGS = (c, s, vx, vy, w, px, py, cd, sd, N, mu, amax, b, fre, cap, eps)
+
+# --- proofs --------------------------------------------------------------------
+
+
+def _symbolic_claims():
+    """Chassis identities with arbitrary wheel-frame forces (F_l, F_s): the
+    scene force is the wheel force rotated by psi + delta, with norm
+    |F_l, F_s| (so a force inside its friction circle stays inside, and
+    m dv/dt = sum F is the momentum balance), and its power
+    Fx vx + Fy vy + Mz w equals the power at the contact point F_l u_l + F_s u_s."""
+    fl, fs = sp.symbols("F_l F_s", real=True)
+    delta = sp.Symbol("delta", real=True)
+    rep = {cd: sp.cos(delta), sd: sp.sin(delta)}
+    fx, fy, mz = chassis(fl, fs)
+    rot = (
+        sp.cos(psi + delta) * fl - sp.sin(psi + delta) * fs,
+        sp.sin(psi + delta) * fl + sp.cos(psi + delta) * fs,
+    )
+    same = all(sp.simplify(sp.expand_trig((a - r).xreplace(rep))) == 0 for a, r in zip((fx, fy), rot))
+    _, (ul, us) = contact_velocity()
+    power = fx * vx + fy * vy + mz * w - (fl * ul + fs * us)
+    zero = sp.simplify(sp.expand_trig(sp.expand(power.xreplace(rep)))) == 0
+    return [
+        ("run-out: a wheel's scene-frame force is its wheel-frame force rotated by psi + delta", same),
+        ("run-out: power of a wheel force on the body Fx vx + Fy vy + Mz w = F_l u_l + F_s u_s", zero),
+    ]
+
+
+def _mp_functions(expr_list, args):
+    """`expr_list` evaluated with mpmath at the working precision."""
+    clip = lambda z, k: max(-k, min(z, k))  # noqa: E731
+    slope = lambda z, k: mpmath.mpf(1) if abs(z) < k else mpmath.mpf(0)  # noqa: E731
+    modulus = lambda e, *u: max(mpmath.sqrt(sum(x * x for x in u)), e)  # noqa: E731
+    step = lambda e, *u: mpmath.mpf(1) if sum(x * x for x in u) > e * e else mpmath.mpf(0)  # noqa: E731
+    fns = {"Clip": clip, "ClipSlope": slope, "Modulus": modulus, "ModulusStep": step, "sign": mpmath.sign}
+    mods = [fns, "mpmath"]
+    return sp.lambdify(args, expr_list, modules=mods)
+
+
+def _random_state(rng: random.Random, locked: bool):
+    """A random wheel situation, one in five at speeds comparable with eps."""
+    scale = 0.01 if rng.random() < 0.2 else 20.0
+    brake = 0.0 if locked or rng.random() < 0.4 else rng.random()
+    return {
+        psi: rng.uniform(-7, 7),
+        vx: rng.uniform(-scale, scale),
+        vy: rng.uniform(-scale, scale),
+        w: rng.uniform(-scale, scale) / 2,
+        px: rng.uniform(-2, 2),
+        py: rng.uniform(-1, 1),
+        sp.Symbol("delta"): rng.uniform(-0.6, 0.6),
+        N: rng.uniform(1000, 6000),
+        mu: rng.uniform(0.1, 1.2),
+        amax: rng.uniform(0.02, 0.5),
+        b: brake,
+        fre: 0.0 if brake > 0 else rng.uniform(0, 0.05),
+        eps: EPS,
+    }
+
+
+def _numeric_claims(samples: int = 300):
+    """Friction circle, dissipation and the Jacobians, at 50 digits on random states."""
+    rng = random.Random(960886)
+    args = (psi, vx, vy, w, px, py, sp.Symbol("delta"), N, mu, amax, b, fre, eps)
+    results = []
+    with mpmath.workdps(50):
+        for locked in (True, False):
+            fl, fs = wheel_frame_forces(locked)
+            _, (ul, us) = contact_velocity()
+            exprs = [e.xreplace({cap: sp.sqrt(1 - b**2)}) for e in (fl, fs, fl * ul + fs * us)]
+            jac = [sp.diff(f, z) for f in scene_forces(locked) for z in Z]
+            forces = [e.xreplace({cap: sp.sqrt(1 - b**2)}) for e in scene_forces(locked)]
+            delta = sp.Symbol("delta")
+            rep = {cd: sp.cos(delta), sd: sp.sin(delta)}
+            f_num = _mp_functions([e.xreplace(rep) for e in exprs], args)
+            g_num = _mp_functions([e.xreplace(rep).xreplace({cap: sp.sqrt(1 - b**2)}) for e in forces], args)
+            j_num = _mp_functions([e.xreplace(rep).xreplace({cap: sp.sqrt(1 - b**2)}) for e in jac], args)
+            circle = power = grip = jac_ok = True
+            worst_jac = mpmath.mpf(0)
+            for _ in range(samples):
+                st = _random_state(rng, locked)
+                vals = [mpmath.mpf(st[a]) for a in args]
+                f_l, f_s, p = f_num(*vals)
+                n_mu = vals[7] * vals[8]
+                room = 1 + mpmath.mpf(10) ** -40  # on the circle (|u| >= eps) up to 50-digit rounding
+                if locked or vals[10] > 0:
+                    circle &= f_l**2 + f_s**2 <= n_mu**2 * room
+                else:  # rolling resistance is a loss in the tyre, not grip
+                    grip &= (
+                        abs(f_s) <= n_mu * room
+                        and f_l**2 + f_s**2 <= (n_mu**2 + (vals[11] * vals[7]) ** 2) * room
+                    )
+                power &= p <= 0
+                jac_ok, worst_jac = _check_jacobian(g_num, j_num, vals, jac_ok, worst_jac)
+            kind = "locked" if locked else "rolling/braked"
+            results.append(
+                (
+                    f"run-out: {kind} wheel force inside its friction circle |F| <= mu N "
+                    f"({samples} random states, 50 digits)",
+                    circle,
+                )
+            )
+            if not locked:
+                results.append(
+                    (
+                        "run-out: plain rolling wheel: lateral grip |F_s| <= mu N, and |F| <= "
+                        "sqrt(mu^2 + f_r^2) N (rolling resistance on top)",
+                        grip,
+                    )
+                )
+            results.append((f"run-out: {kind} wheel power F.u <= 0 (dissipative)", power))
+            results.append(
+                (
+                    f"run-out: {kind} wheel Jacobian d(Fx,Fy,Mz)/d(psi,vx,vy,w,mu) = central "
+                    f"differences (worst relative {mpmath.nstr(worst_jac, 3)})",
+                    jac_ok,
+                )
+            )
+    return results
+
+
+def _check_jacobian(g_num, j_num, vals, ok, worst):
+    """Compare the symbolic Jacobian with 50-digit central differences at one
+    state; a coordinate where the one-sided differences disagree (the state sits
+    on the lateral-saturation kink) is skipped."""
+    h = mpmath.mpf(10) ** -20
+    jac, f0 = j_num(*vals), g_num(*vals)
+    for k, at in enumerate((0, 1, 2, 3, 8)):  # psi, vx, vy, w, mu among the arguments
+        up, dn = list(vals), list(vals)
+        up[at] += h
+        dn[at] -= h
+        fu, fd = g_num(*up), g_num(*dn)
+        for row in range(3):
+            scale = max(abs(jac[row * 5 + k]), mpmath.mpf(1))
+            right, left = (fu[row] - f0[row]) / h, (f0[row] - fd[row]) / h
+            if abs(right - left) > scale * mpmath.mpf(10) ** -15:
+                continue  # on the kink
+            err = abs((fu[row] - fd[row]) / (2 * h) - jac[row * 5 + k]) / scale
+            worst = max(worst, err)
+            ok = ok and err < mpmath.mpf(10) ** -15
+    return ok, worst
+
+
+def proofs():
+    """(claim, passed) for the run-out model."""
+    return _symbolic_claims() + _numeric_claims()
+
+
+# --- emission ------------------------------------------------------------------
+
+
+class RunoutPrinter(emit.KernelPrinter):
+    """The kernel printer plus the saturation functions of the lateral law."""
+
+    def _print_Clip(self, expr):
+        z, k = (self._print(a) for a in expr.args)
+        return f"min(max({z}, -{k}), {k})"
+
+    def _print_ClipSlope(self, expr):
+        z, k = (self._print(a) for a in expr.args)
+        return f"(1.0 if abs({z}) < {k} else 0.0)"
+
+    def _print_Modulus(self, expr):
+        e, *u = (self._print(a) for a in expr.args)
+        if len(u) == 1:
+            return f"max(abs({u[0]}), {e})"
+        return f"max(math.sqrt({' + '.join(f'{x}*{x}' for x in u)}), {e})"
+
+    def _print_ModulusStep(self, expr):
+        e, *u = (self._print(a) for a in expr.args)
+        return f"(1.0 if {' + '.join(f'{x}*{x}' for x in u)} > {e}*{e} else 0.0)"
+
+    def _print_sign(self, expr):
+        return f"math.copysign(1.0, {self._print(expr.args[0])})"
+
+
+PRINTER = RunoutPrinter({"fully_qualified_modules": True, "standard": "python3"})
+JIT = 'njit(cache=True, error_model="numpy")'
+
+
+def wheel_function(name: str, locked: bool, jacobian: bool) -> tuple[str, int]:
+    """One wheel's (Fx, Fy, Mz) [and their derivatives] as numba source, and its
+    operation count after common-subexpression elimination."""
+    outs = wheel_outputs(locked, jacobian)
+    temps, reduced = sp.cse(outs, symbols=sp.numbered_symbols("_t"))
+    ops = int(sum(sp.count_ops(x) for _, x in temps) + sum(sp.count_ops(x) for x in reduced))
+    kind = (
+        "locked: F = -mu N u/|u|"
+        if locked
+        else "rolling/braked: F_l = -(b mu + f) N sgn(u_l), F_s = -mu N clip(alpha/alpha_max, cap)"
+    )
+    what = "(Fx, Fy, Mz) and d/d(psi, vx, vy, w, mu) of each, row by row" if jacobian else "(Fx, Fy, Mz)"
+    lines = [f"@{JIT}"]
+    lines += emit._wrap(f"def {name}(", [str(a) for a in WHEEL_ARGS], "):", " " * 8)
+    lines.append(f'    """Wheel {kind} (conventions.md, run-out; derive/runout.py): {what}."""')
+    lines += [f"    {t} = {PRINTER.doprint(x)}" for t, x in temps]
+    lines += emit._wrap("    return (", [PRINTER.doprint(x) for x in reduced], ")", " " * 8)
+    return "\n".join(lines) + "\n", ops
+
+
+def _constants() -> list[str]:
+    return [
+        f"EPS = {EPS!r}  # m/s, smoothing speed of sgn and |.|",
+        f"V_STOP = {V_STOP!r}  # m/s, at rest when |v| + |w| R_max < V_STOP",
+        f"T_MAX = {T_MAX!r}  # s",
+        f"MAX_STEPS = {MAX_STEPS!r}",
+        f"TOL = {TOL!r}  # default local error tolerance per step",
+        f"H0 = {H0!r}  # s",
+        f"H_MAX = {H_MAX!r}  # s",
+    ] + [f"STATUS_{k} = {v!r}" for k, v in STATUS.items()]
+
+
+def render_plain(digest: str) -> str:
+    """generated/runout.py: constants, columns, outputs and status texts (plain Python)."""
+    parts = [
+        emit.header("runout.py", digest).rstrip("\n"),
+        "# 0 kernels, 0 arithmetic operations after common-subexpression elimination: constants only;",
+        "# the wheel forces, batch driver and integrator are in generated/runout_jit.py.",
+        "",
+        '"""Post-impact run-out: constants, batch columns and status codes (numba code: runout_jit.py)."""',
+        "",
+        "import math",
+        "",
+        *_constants(),
+        "",
+        f"COLUMNS = {COLUMNS!r}",
+        f"OUTPUTS = {OUTPUTS!r}",
+        f"SENSITIVITIES = {SENSITIVITIES!r}",
+        f"STATUS_TEXT = {STATUS_TEXT!r}",
+        f"WHEELS = {WHEELS!r}",
+        "GRAVITY_SI = 9.80665",
+        "RIGHT_ANGLE = math.pi / 2",
+    ]
+    return "\n".join(parts) + "\n"
+
+
+def render(digest: str) -> dict[str, str]:
+    """File name -> text of the run-out's generated files."""
+    funcs, ops, counts = [], [], []
+    for name, locked, jac in (
+        ("_wheel_locked", True, False),
+        ("_wheel_rolling", False, False),
+        ("_wheel_locked_jac", True, True),
+        ("_wheel_rolling_jac", False, True),
+    ):
+        text, count = wheel_function(name, locked, jac)
+        funcs.append(text)
+        counts.append(count)
+        ops.append(f"#   {name}: {count} operations")
+    parts = [
+        emit.header("runout.py", digest).rstrip("\n"),
+        f"# {len(ops)} wheel-force kernels, {sum(counts)} arithmetic operations after "
+        "common-subexpression elimination:",
+        *ops,
+        "",
+        '"""Post-impact run-out (numba): wheel forces, right-hand side with sensitivities,',
+        'Dormand-Prince 5(4) integrator to rest and its batch drivers (derive/runout.py)."""',
+        "",
+        "import math",
+        "",
+        "import numpy as np",
+        "from numba import njit, prange",
+        "",
+        *_constants(),
+        "",
+        *("\n" + f for f in funcs),
+        INTEGRATOR_SOURCE,
+    ]
+    return {"runout.py": render_plain(digest), "runout_jit.py": "\n".join(parts).rstrip("\n") + "\n"}
+
+
+def _sensitivity_lines() -> str:
+    """dS/dt = J S (+ df/dmu in the mu column) for the 6 x 4 sensitivity block
+    S[i, j] = y[7 + 4 i + j] (j: vx, vy, w at separation, then mu)."""
+    lines = []
+    for j in range(4):
+        sj = [f"y[{7 + 4 * i + j}]" for i in range(6)]
+        lines += [
+            f"        f[{7 + 4 * 0 + j}] = {sj[3]}",
+            f"        f[{7 + 4 * 1 + j}] = {sj[4]}",
+            f"        f[{7 + 4 * 2 + j}] = {sj[5]}",
+        ]
+        for row, (acc, div) in enumerate((("x", "m"), ("y", "m"), ("z", "inertia"))):
+            terms = " + ".join(f"d{acc}{k}*{sj[2 + k]}" for k in range(4))
+            extra = f" + d{acc}4" if j == 3 else ""
+            lines.append(f"        f[{7 + 4 * (3 + row) + j}] = ({terms}{extra})/{div}")
+    return "\n".join(lines)
+
+
+INTEGRATOR_SOURCE = '''
+
+# Per-row tables built by _setup: P = (m, I, mu, alpha_max, eps, R_max) and
+# W[k] = (px, py, cos delta, sin delta, N, b, f, cap, locked) for k = fl, fr, rl, rr.
+
+
+@__JIT__
+def _rhs(y, P, W, f):
+    """State derivative f(y), y = (x, y, psi, vx, vy, w, distance):
+    m dv/dt = sum F, I dw/dt = sum Mz, d distance/dt = |v| (conventions.md, run-out)."""
+    c = math.cos(y[2])
+    s = math.sin(y[2])
+    vx, vy, w = y[3], y[4], y[5]
+    m, inertia, mu, amax, eps = P[0], P[1], P[2], P[3], P[4]
+    fx = 0.0
+    fy = 0.0
+    mz = 0.0
+    for k in range(4):
+        px, py, cd, sd, n = W[k, 0], W[k, 1], W[k, 2], W[k, 3], W[k, 4]
+        b, fre, cap = W[k, 5], W[k, 6], W[k, 7]
+        if W[k, 8] != 0.0:
+            r = _wheel_locked(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
+        else:
+            r = _wheel_rolling(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
+        fx += r[0]
+        fy += r[1]
+        mz += r[2]
+    f[0] = vx
+    f[1] = vy
+    f[2] = w
+    f[3] = fx/m
+    f[4] = fy/m
+    f[5] = mz/inertia
+    f[6] = math.sqrt(vx*vx + vy*vy)
+
+
+@__JIT__
+def _rhs_sens(y, P, W, f):
+    """_rhs and the sensitivity equations dS/dt = J S (+ df/dmu), S[i, j] =
+    y[7 + 4 i + j] = d y_i/d(vx, vy, w at separation, mu)_j."""
+    c = math.cos(y[2])
+    s = math.sin(y[2])
+    vx, vy, w = y[3], y[4], y[5]
+    m, inertia, mu, amax, eps = P[0], P[1], P[2], P[3], P[4]
+    fx = 0.0
+    fy = 0.0
+    mz = 0.0
+__ACC_INIT__
+    for k in range(4):
+        px, py, cd, sd, n = W[k, 0], W[k, 1], W[k, 2], W[k, 3], W[k, 4]
+        b, fre, cap = W[k, 5], W[k, 6], W[k, 7]
+        if W[k, 8] != 0.0:
+            r = _wheel_locked_jac(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
+        else:
+            r = _wheel_rolling_jac(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
+__ACC_ADD__
+    f[0] = vx
+    f[1] = vy
+    f[2] = w
+    f[3] = fx/m
+    f[4] = fy/m
+    f[5] = mz/inertia
+    f[6] = math.sqrt(vx*vx + vy*vy)
+__SENS__
+
+
+@__JIT__
+def _speed(y, P):
+    """|v| + |w| R_max: the fastest any wheel can move."""
+    return math.sqrt(y[3]*y[3] + y[4]*y[4]) + abs(y[5])*P[5]
+
+
+__INTEGRATE__@__JIT__
+def _check(v):
+    """The row's status before integration (0: fine). v holds the COLUMNS values."""
+    for i in range(v.shape[0]):
+        if not math.isfinite(v[i]):
+            return STATUS_NONFINITE_INPUT
+    if not (v[0] > 0.0 and v[1] > 0.0):
+        return STATUS_BAD_MASS
+    if not (v[2] > 0.0 and v[3] > 0.0 and v[3] < v[2] and v[4] > 0.0):
+        return STATUS_RUNOUT_BAD_GEOMETRY
+    if not (v[5] > 0.0 and v[6] > 0.0 and v[6] < 0.5*math.pi and v[7] >= 0.0 and v[8] > 0.0):
+        return STATUS_RUNOUT_BAD_TYRE
+    for k in range(4):
+        state, brake, steer = v[15 + 3*k], v[16 + 3*k], v[17 + 3*k]
+        if not ((state == 0.0 or state == 1.0) and brake >= 0.0 and brake <= 1.0 and abs(steer) < 0.5*math.pi):
+            return STATUS_RUNOUT_BAD_WHEEL
+    return STATUS_OK
+
+
+@__JIT__
+def _setup(v, eps):
+    """(y, P, W) of a checked row: state at separation, vehicle and wheel tables.
+    Static loads m g b/(2L) front, m g a/(2L) rear; wheels at (a, +-track/2)
+    and (-b, +-track/2), left first (conventions.md, run-out)."""
+    m, inertia, wb, a, track, mu, amax, f_r, g = v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8]
+    b_ = wb - a
+    half = 0.5*track
+    W = np.empty((4, 9))
+    xs = (a, a, -b_, -b_)
+    ys = (half, -half, half, -half)
+    loads = (m*g*b_/(2.0*wb), m*g*b_/(2.0*wb), m*g*a/(2.0*wb), m*g*a/(2.0*wb))
+    for k in range(4):
+        state, brake, steer = v[15 + 3*k], v[16 + 3*k], v[17 + 3*k]
+        W[k, 0] = xs[k]
+        W[k, 1] = ys[k]
+        W[k, 2] = math.cos(steer)
+        W[k, 3] = math.sin(steer)
+        W[k, 4] = loads[k]
+        W[k, 5] = brake
+        W[k, 6] = f_r if brake == 0.0 else 0.0
+        W[k, 7] = math.sqrt((1.0 - brake)*(1.0 + brake))
+        W[k, 8] = state
+    P = np.empty(6)
+    P[0], P[1], P[2], P[3], P[4] = m, inertia, mu, amax, eps
+    P[5] = math.sqrt(max(a, b_)**2 + half*half)
+    return P, W
+
+
+__ROW____BATCH__'''
+INTEGRATE_TEMPLATE = '''@__JIT__
+def _integrate__SUFFIX__(y, P, W, tol, path):
+    """Adaptive Dormand-Prince 5(4) (FSAL, local extrapolation) from t = 0 until
+    the vehicle stops (_speed < V_STOP), in place on y. The local error of the
+    state (x, y, psi, vx, vy, w) is kept below `tol` (absolute, SI) per step;
+    the distance and the sensitivities ride on the same steps. Accepted points
+    (t, x, y, psi) go to `path` while it has room. Returns (t, status, steps,
+    points)."""
+    n = y.shape[0]
+    k1 = np.empty(n)
+    k2 = np.empty(n)
+    k3 = np.empty(n)
+    k4 = np.empty(n)
+    k5 = np.empty(n)
+    k6 = np.empty(n)
+    k7 = np.empty(n)
+    z = np.empty(n)
+    t = 0.0
+    h = H0
+    steps = 0
+    points = 0
+    if path.shape[0] > 0:
+        path[0, 0], path[0, 1], path[0, 2], path[0, 3] = 0.0, y[0], y[1], y[2]
+        points = 1
+    if _speed(y, P) < V_STOP:
+        return t, STATUS_OK, steps, points
+    _rhs__SUFFIX__(y, P, W, k1)
+    while True:
+        if steps >= MAX_STEPS or t >= T_MAX:
+            return t, STATUS_RUNOUT_NOT_STOPPED, steps, points
+        steps += 1
+        for i in range(n):
+            z[i] = y[i] + h*(0.2*k1[i])
+        _rhs__SUFFIX__(z, P, W, k2)
+        for i in range(n):
+            z[i] = y[i] + h*(0.075*k1[i] + 0.225*k2[i])
+        _rhs__SUFFIX__(z, P, W, k3)
+        for i in range(n):
+            z[i] = y[i] + h*((44.0/45.0)*k1[i] - (56.0/15.0)*k2[i] + (32.0/9.0)*k3[i])
+        _rhs__SUFFIX__(z, P, W, k4)
+        for i in range(n):
+            z[i] = y[i] + h*((19372.0/6561.0)*k1[i] - (25360.0/2187.0)*k2[i] + (64448.0/6561.0)*k3[i]
+                             - (212.0/729.0)*k4[i])
+        _rhs__SUFFIX__(z, P, W, k5)
+        for i in range(n):
+            z[i] = y[i] + h*((9017.0/3168.0)*k1[i] - (355.0/33.0)*k2[i] + (46732.0/5247.0)*k3[i]
+                             + (49.0/176.0)*k4[i] - (5103.0/18656.0)*k5[i])
+        _rhs__SUFFIX__(z, P, W, k6)
+        for i in range(n):
+            z[i] = y[i] + h*((35.0/384.0)*k1[i] + (500.0/1113.0)*k3[i] + (125.0/192.0)*k4[i]
+                             - (2187.0/6784.0)*k5[i] + (11.0/84.0)*k6[i])
+        _rhs__SUFFIX__(z, P, W, k7)
+        err = 0.0
+        for i in range(6):
+            e = h*((71.0/57600.0)*k1[i] - (71.0/16695.0)*k3[i] + (71.0/1920.0)*k4[i]
+                   - (17253.0/339200.0)*k5[i] + (22.0/525.0)*k6[i] - (1.0/40.0)*k7[i])
+            err = max(err, abs(e)/tol)
+        if not (err <= 1.0):  # rejected (NaN included)
+            if not math.isfinite(err):
+                h *= 0.1
+            else:
+                h *= max(0.2, 0.9*err**-0.2)
+            continue
+        t += h
+        for i in range(n):
+            y[i] = z[i]
+            k1[i] = k7[i]
+        if points < path.shape[0]:
+            path[points, 0], path[points, 1], path[points, 2], path[points, 3] = t, y[0], y[1], y[2]
+            points += 1
+        if _speed(y, P) < V_STOP:
+            return t, STATUS_OK, steps, points
+        grow = 5.0 if err < 1e-10 else min(5.0, 0.9*err**-0.2)
+        h = min(h*grow, H_MAX)
+
+
+'''
+ROW_TEMPLATE = '''@__JIT__
+def runout_row__SUFFIX__(v, tol, eps, path):
+    """One run-out: v the COLUMNS values (SI, radians). Returns (y, t, status,
+    steps, points): y = (x, y, psi, vx, vy, w, distance) at rest__DOC__."""
+    n = __N__
+    y = np.zeros(n)
+    status = _check(v)
+    if status != STATUS_OK:
+        y[:] = np.nan
+        return y, np.nan, status, 0, 0
+    P, W = _setup(v, eps)
+    for i in range(6):
+        y[i] = v[9 + i]
+__SINIT__    t, status, steps, points = _integrate__SUFFIX__(y, P, W, tol, path)
+    if status != STATUS_OK:
+        y[:] = np.nan
+    return y, t, status, steps, points
+
+
+'''
+BATCH_TEMPLATE = '''@__DECORATOR__
+def __NAME__(c, out_x_rest, out_y_rest, out_psi_rest, out_t, out_distance, out_status, out_steps, tol, eps):
+    """__KIND__ rows of runout_row; c is the (rows, COLUMNS) input table. (Two
+    separate functions, not one wrapped twice: numba's cache keys a compiled
+    function by its definition, so the two wrappers would share one entry.)"""
+    empty = np.empty((0, 4))
+    for i in __RANGE__(c.shape[0]):
+        y, t, status, steps, _ = runout_row(c[i], tol, eps, empty)
+        out_x_rest[i] = y[0]
+        out_y_rest[i] = y[1]
+        out_psi_rest[i] = y[2]
+        out_t[i] = t
+        out_distance[i] = y[6]
+        out_status[i] = status
+        out_steps[i] = steps
+'''
+ACC = [f"d{a}{k}" for a in "xyz" for k in range(5)]
+INTEGRATOR_SOURCE = (
+    INTEGRATOR_SOURCE.replace("__JIT__", JIT)
+    .replace("__ACC_INIT__", "\n".join(f"    {name} = 0.0" for name in ACC))
+    .replace(
+        "__ACC_ADD__",
+        "\n".join(
+            ["        fx += r[0]", "        fy += r[1]", "        mz += r[2]"]
+            + [f"        {name} += r[{3 + i}]" for i, name in enumerate(ACC)]
+        ),
+    )
+    .replace("__SENS__", "\n".join(line[4:] for line in _sensitivity_lines().splitlines()))
+    .replace(
+        "__INTEGRATE__",
+        INTEGRATE_TEMPLATE.replace("__SUFFIX__", "")
+        + "\n\n"
+        + INTEGRATE_TEMPLATE.replace("__SUFFIX__", "_sens"),
+    )
+    .replace(
+        "__ROW__",
+        ROW_TEMPLATE.replace("__SUFFIX__", "")
+        .replace("__N__", "7")
+        .replace("__DOC__", "")
+        .replace("__SINIT__", "")
+        + "\n\n"
+        + ROW_TEMPLATE.replace("__SUFFIX__", "_sens")
+        .replace("__N__", "31")
+        .replace(
+            "__DOC__",
+            ", then the sensitivities S[i, j] = d y_i/d p_j at y[7 + 4 i + j], p = (vx, vy, w at separation, mu)",
+        )
+        .replace(
+            "__SINIT__", "    y[7 + 4*3 + 0] = 1.0\n    y[7 + 4*4 + 1] = 1.0\n    y[7 + 4*5 + 2] = 1.0\n"
+        ),
+    )
+    .replace(
+        "__BATCH__",
+        BATCH_TEMPLATE.replace("__DECORATOR__", 'njit(cache=True, error_model="numpy", parallel=True)')
+        .replace("__NAME__", "runout_batch")
+        .replace("__KIND__", "Parallel")
+        .replace("__RANGE__", "prange")
+        + "\n\n"
+        + BATCH_TEMPLATE.replace("__DECORATOR__", JIT)
+        .replace("__NAME__", "runout_batch_serial")
+        .replace("__KIND__", "Serial")
+        .replace("__RANGE__", "range"),
+    )
+    .replace("__JIT__", JIT)
+)

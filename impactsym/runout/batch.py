@@ -1,0 +1,112 @@
+"""`runout_batch(columns)`: one run-out per row, separation to rest (SI, radians).
+
+Columns (conventions.md, "Post-impact run-out"): ``m I L a track mu alpha_max f_r g
+x y psi vx vy w`` and per wheel k in ``fl fr rl rr``: ``state_k`` (0 rolling, 1
+locked), ``brake_k`` (0..1), ``steer_k`` (rad). ``alpha_max`` (default 10 deg in
+rad), ``f_r`` (0.01), ``g`` (9.80665) and the wheel columns (0) may be left out:
+the documented defaults of a scene file. Outputs ``x_rest y_rest psi_rest``
+(psi unwrapped) ``t distance status steps``; a row with ``status != 0`` has NaN
+outputs (codes: :data:`STATUS_TEXT`) and the other rows are unaffected.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import SceneError
+from . import _door
+
+DEFAULTS = {"alpha_max": math.radians(10.0), "f_r": 0.01, "g": 9.80665}
+WHEEL_DEFAULT = 0.0
+
+
+def columns() -> tuple[str, ...]:
+    """The input columns, in the kernel's order."""
+    return _door.plain().COLUMNS
+
+
+def status_text(code: int) -> str:
+    """What a row status means."""
+    return "solved" if code == 0 else _door.plain().STATUS_TEXT.get(int(code), f"status {code}")
+
+
+def input_table(cols) -> np.ndarray:
+    """The (rows, COLUMNS) float64 table of a mapping of columns (arrays or scalars)."""
+    names = columns()
+    known = set(names)
+    for key in cols:
+        if key not in known:
+            raise SceneError(f"unknown column (known: {', '.join(names)})", str(key))
+    values, n = [], None
+    for name in names:
+        if name in cols:
+            value = np.asarray(cols[name], dtype=np.float64)
+        elif name in DEFAULTS:
+            value = np.float64(DEFAULTS[name])
+        elif name.startswith(("state_", "brake_", "steer_")):
+            value = np.float64(WHEEL_DEFAULT)
+        else:
+            raise SceneError("missing column", name)
+        if value.ndim > 1:
+            raise SceneError(f"must be a scalar or a 1-D array, got shape {value.shape}", name)
+        if value.ndim == 1:
+            if n is not None and value.shape[0] != n:
+                raise SceneError(f"has {value.shape[0]} rows, other columns {n}", name)
+            n = value.shape[0]
+        values.append(value)
+    n = 1 if n is None else n
+    return np.ascontiguousarray(np.stack([np.broadcast_to(v, (n,)) for v in values], axis=1))
+
+
+def runout_batch(cols, tol: float | None = None, parallel: bool | None = None) -> dict:
+    """Run every row to rest; returns a dict of output arrays (see the module doc).
+
+    `tol` is the integrator's local error tolerance per step (SI, absolute;
+    default generated TOL, measured in docs/runout.md)."""
+    table = input_table(cols)
+    n = table.shape[0]
+    plain, jit = _door.plain(), _door.jit()
+    tol = plain.TOL if tol is None else float(tol)
+    out = {name: np.empty(n) for name in ("x_rest", "y_rest", "psi_rest", "t", "distance")}
+    status = np.empty(n, dtype=np.int64)
+    steps = np.empty(n, dtype=np.int64)
+    driver = jit.runout_batch if (parallel if parallel is not None else n >= 8) else jit.runout_batch_serial
+    driver(
+        table,
+        out["x_rest"],
+        out["y_rest"],
+        out["psi_rest"],
+        out["t"],
+        out["distance"],
+        status,
+        steps,
+        tol,
+        plain.EPS,
+    )
+    out["status"] = status
+    out["steps"] = steps
+    return out
+
+
+def run_row(
+    values: np.ndarray,
+    tol: float | None = None,
+    sens: bool = False,
+    path_points: int = 0,
+    eps: float | None = None,
+):
+    """One row (the COLUMNS values): (y, t, status, steps, path). y = (x, y, psi,
+    vx, vy, w, distance) at rest, then with `sens` d y_i/d(vx, vy, w, mu) at
+    y[7 + 4 i + j]; `path` is (points, 4) of (t, x, y, psi) when asked."""
+    plain, jit = _door.plain(), _door.jit()
+    buffer = np.empty((path_points, 4))
+    row = jit.runout_row_sens if sens else jit.runout_row
+    y, t, status, steps, points = row(
+        np.ascontiguousarray(values, dtype=np.float64),
+        plain.TOL if tol is None else float(tol),
+        plain.EPS if eps is None else float(eps),
+        buffer,
+    )
+    return y, t, int(status), int(steps), buffer[:points]

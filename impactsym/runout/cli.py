@@ -1,0 +1,145 @@
+"""`impactsym runout SCENE [--json] [--path] [--plot OUT.png]`.
+
+Registered in impactsym/cli.py's COMMANDS (help, add_arguments, run). A bad
+scene raises SceneError, which the command line prints as one line (exit 2).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from ..errors import SceneError
+from ..result import json_clean
+from .api import runout
+
+HELP = "post-impact run-out: each vehicle from separation to rest, or its separation velocity fitted to rest"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """The command's arguments."""
+    parser.add_argument("scene", help="scene file (.json or .toml) with a runout object")
+    parser.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    parser.add_argument("--path", action="store_true", help="add each vehicle's path [[t, x, y, psi], ...]")
+    parser.add_argument("--plot", metavar="OUT.png", help="draw the paths, outlines, tyre marks and poses")
+    parser.add_argument(
+        "--chain",
+        choices=("solve", "reconstruct"),
+        help="solve: pre-impact -> impact -> rest (solve --json plus each rest); reconstruct: rest -> fitted "
+        "separation -> pre-impact (reconstruct --json plus each run-out)",
+    )
+
+
+def add_parser(subparsers) -> argparse.ArgumentParser:
+    """Add the ``runout`` sub-command to an argparse sub-parser set."""
+    parser = subparsers.add_parser("runout", help=HELP, description=HELP)
+    add_arguments(parser)
+    return parser
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the command; 0 on success (bad input raises SceneError)."""
+    from .scene import load_runout
+
+    if args.chain:
+        return _run_chain(args)
+    scene = load_runout(args.scene)
+    result = runout(scene, path=bool(args.path or args.plot))
+    if args.plot:
+        from .plot import plot_runout
+
+        plot_runout(scene, result, args.plot)
+    if not args.path:
+        for entry in result["vehicles"]:
+            entry.pop("path", None)
+    if args.json:
+        print(json.dumps(json_clean(result)))
+    else:
+        print(table(result))
+    return 0
+
+
+def chained(args: argparse.Namespace) -> bool:
+    """Whether the ``solve``/``reconstruct`` scene of `args` carries run-out data
+    (a top-level ``runout`` object): then `run_chained` answers the command."""
+    from ..scene import scene_data
+
+    try:
+        data = scene_data(args.scene)
+    except (OSError, ValueError):
+        return False  # the command's own reading reports it
+    return isinstance(data, dict) and "runout" in data
+
+
+def run_chained(args: argparse.Namespace, command: str) -> int:
+    """``solve``/``reconstruct`` of a scene with run-out data (conventions.md,
+    "Chained"): the command's JSON with each vehicle's run-out attached."""
+    if getattr(args, "uncertainty", None):
+        raise SceneError(
+            "not yet available through the run-out from the command line "
+            "(impactsym.runout.interval.reconstruct_interval gives the intervals)",
+            "--uncertainty",
+        )
+    if getattr(args, "plot", None):
+        raise SceneError("draw a chained scene's run-outs with impactsym runout SCENE --plot", "--plot")
+    from .chain import reconstruct_from_rest, solve_to_rest
+
+    result = (solve_to_rest if command == "solve" else reconstruct_from_rest)(args.scene)
+    print(json.dumps(json_clean(result), indent=2) if args.json else _chain_table(result))
+    return 0
+
+
+def _run_chain(args: argparse.Namespace) -> int:
+    """``--chain``: the impact command's JSON with the run-outs attached."""
+    from .chain import reconstruct_from_rest, solve_to_rest
+
+    if args.plot:
+        raise SceneError("--plot draws a plain run-out; leave out --chain to draw it", "--plot")
+    result = (solve_to_rest if args.chain == "solve" else reconstruct_from_rest)(args.scene, path=args.path)
+    print(json.dumps(json_clean(result)) if args.json else _chain_table(result))
+    return 0
+
+
+def _chain_table(result: dict) -> str:
+    lines = []
+    for v in result["vehicles"]:
+        ro = v.get("runout")
+        head = f"{v.get('name', '')}: velocity {v.get('velocity')}"
+        if ro is None:
+            lines.append(head)
+            continue
+        sep, rest = ro["separation"], ro["rest"]
+        lines += [
+            head,
+            f"  separation velocity [{sep['velocity'][0]:.3f}, {sep['velocity'][1]:.3f}], "
+            f"yaw rate {sep['yaw_rate']:.4f} rad/s",
+            f"  rest [{rest['position'][0]:.3f}, {rest['position'][1]:.3f}], heading {rest['heading']:.2f} deg",
+        ]
+    lines += [f"warning: {w}" for w in result.get("warnings", [])]
+    return "\n".join(lines)
+
+
+def table(result: dict) -> str:
+    """The result for people: one block per vehicle."""
+    unit = "ft" if result["units"] == "US" else "m"
+    lines = []
+    for v in result["vehicles"]:
+        sep, rest = v["separation"], v["rest"]
+        fitted = " (fitted to rest)" if "fit" in v else ""
+        lines += [
+            f"{v['name']}",
+            f"  separation{fitted}: velocity [{sep['velocity'][0]:.3f}, {sep['velocity'][1]:.3f}] {unit}/s "
+            f"(speed {sep['speed']:.3f}), yaw rate {sep['yaw_rate']:.4f} rad/s",
+            f"  rest: position [{rest['position'][0]:.3f}, {rest['position'][1]:.3f}] {unit}, "
+            f"heading {rest['heading']:.2f} deg",
+            f"  time {v['time']:.3f} s, distance {v['distance']:.3f} {unit}, rotation {v['rotation']:.2f} deg",
+        ]
+        res = v.get("fit", v).get("residual")
+        if res is not None:
+            extra = f", {v['fit']['iterations']} iterations" if "fit" in v else ""
+            lines.append(
+                f"  residual against the measured rest: {res['position']:.2g} {unit}, "
+                f"{res['heading']:.2g} deg{extra}"
+            )
+    lines += [f"warning: {w}" for w in result["warnings"]]
+    return "\n".join(lines)

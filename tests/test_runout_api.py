@@ -1,0 +1,286 @@
+"""Run-out scene API, fit to rest and the `impactsym runout` command."""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from impactsym.errors import SceneError
+from impactsym.runout import load_runout, runout
+from impactsym.runout.fit import fit_rest
+
+ROOT = Path(__file__).resolve().parents[1]
+SEDAN = ROOT / "examples" / "runout" / "sedan.json"
+
+
+def _scene():
+    return json.loads(SEDAN.read_text())
+
+
+def test_forward_scene_reports_the_contract_keys():
+    res = runout(_scene())
+    entry = res["vehicles"][0]
+    assert set(entry) >= {"rest", "time", "distance", "rotation", "separation"}
+    assert set(entry["separation"]) >= {"velocity", "speed", "yaw_rate"}
+    assert entry["rotation"] == pytest.approx(entry["rest"]["heading"] - 30.0)
+    assert entry["distance"] >= math.hypot(
+        entry["rest"]["position"][0] + 1.2, entry["rest"]["position"][1] - 0.4
+    )
+
+
+def test_us_units_give_the_same_motion_in_feet():
+    si = _scene()
+    us = copy.deepcopy(si)
+    ft, slug = 0.3048, 14.59390293720636
+    us["units"] = "US"
+    v = us["vehicles"][0]
+    v["mass"] = si["vehicles"][0]["mass"] / slug
+    v["yaw_inertia"] = si["vehicles"][0]["yaw_inertia"] / slug / ft**2
+    for key in ("wheelbase", "cg_to_front_axle", "track"):
+        v[key] = si["vehicles"][0][key] / ft
+    v["separation"]["position"] = [p / ft for p in si["vehicles"][0]["separation"]["position"]]
+    v["separation"]["velocity"] = [p / ft for p in si["vehicles"][0]["separation"]["velocity"]]
+    us["runout"]["gravity"] = 9.80665 / ft
+    a, b = runout(si)["vehicles"][0], runout(us)["vehicles"][0]
+    assert b["rest"]["position"][0] * ft == pytest.approx(a["rest"]["position"][0], abs=1e-6)
+    assert b["rest"]["heading"] == pytest.approx(a["rest"]["heading"], abs=1e-6)
+
+
+@pytest.mark.parametrize(
+    "edit, field",
+    [
+        (lambda s: s["runout"].pop("friction"), "runout.friction"),
+        (lambda s: s["vehicles"][0].update(mass=-1), "vehicles[0].mass"),
+        (lambda s: s["vehicles"][0].update(cg_to_front_axle=3.0), "vehicles[0].cg_to_front_axle"),
+        (
+            lambda s: s["vehicles"][0]["wheels"].update(front_left={"brak": 0.3}),
+            "vehicles[0].wheels.front_left.brak",
+        ),
+        (
+            lambda s: s["vehicles"][0]["wheels"].update(rear_left={"brake": 1.5}),
+            "vehicles[0].wheels.rear_left.brake",
+        ),
+        (lambda s: s["vehicles"][0]["separation"].pop("yaw_rate"), "vehicles[0].separation.yaw_rate"),
+        (
+            lambda s: s["vehicles"][0]["separation"].update(velocity=[1.0, float("nan")]),
+            "vehicles[0].separation.velocity[1]",
+        ),
+        (lambda s: s.update(runout={"friction": 0.7, "slip_angel_max": 10}), "runout.slip_angel_max"),
+    ],
+)
+def test_bad_scenes_are_refused_with_one_line_naming_the_field(edit, field):
+    scene = _scene()
+    edit(scene)
+    with pytest.raises(SceneError) as err:
+        runout(scene)
+    assert err.value.field == field and "\n" not in str(err.value)
+
+
+@pytest.mark.parametrize(
+    "wheels, velocity, w",
+    [
+        (
+            {
+                "front_left": "locked",
+                "front_right": "locked",
+                "rear_left": "rolling",
+                "rear_right": "rolling",
+            },
+            [9.0, 2.0],
+            1.2,
+        ),
+        ("locked", [7.0, -3.0], -0.8),
+        (
+            {
+                "front_left": "locked",
+                "front_right": "rolling",
+                "rear_left": {"brake": 0.5},
+                "rear_right": {"steer": -5},
+            },
+            [8.0, 3.0],
+            1.2,
+        ),
+    ],
+)
+def test_fit_round_trip_recovers_the_separation_state(wheels, velocity, w):
+    scene = _scene()
+    v = scene["vehicles"][0]
+    v["wheels"] = wheels
+    v["separation"].update(velocity=velocity, yaw_rate=w)
+    forward = runout(scene)["vehicles"][0]
+    del v["separation"]["velocity"], v["separation"]["yaw_rate"]
+    v["rest"] = forward["rest"]
+    veh = load_runout(scene).vehicles[0]
+    fit = fit_rest(veh)
+    assert fit.converged
+    found = [fit] + fit.alternatives
+    best = min(found, key=lambda f: math.hypot(f.velocity[0] - velocity[0], f.velocity[1] - velocity[1]))
+    assert math.hypot(best.velocity[0] - velocity[0], best.velocity[1] - velocity[1]) < 0.01
+    assert abs(best.yaw_rate - w) < 0.01
+    if best is not fit:  # the given state is not the reported one: the scene must say so
+        assert runout(scene)["warnings"]
+    entry = runout(scene)["vehicles"][0]
+    assert entry["fit"]["residual"]["position"] < 1e-3 and entry["fit"]["iterations"] >= 0
+
+
+def _cli(*args):
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    return subprocess.run(
+        [sys.executable, "-m", "impactsym", "runout", *args],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=300,
+    )
+
+
+def test_cli_json_path_and_plot(tmp_path):
+    out = tmp_path / "runout.png"
+    proc = _cli(str(SEDAN), "--json", "--path", "--plot", str(out))
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(proc.stdout)
+    entry = data["vehicles"][0]
+    assert entry["path"][0][0] == 0.0 and len(entry["path"][0]) == 4
+    assert entry["path"][-1][1] == pytest.approx(entry["rest"]["position"][0])
+    assert out.stat().st_size > 10_000
+
+
+def test_cli_bad_scene_exits_2_with_one_line(tmp_path):
+    scene = _scene()
+    scene["vehicles"][0]["mass"] = 0
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(scene))
+    proc = _cli(str(path), "--json")
+    assert proc.returncode == 2
+    assert proc.stderr.strip().count("\n") == 0 and "vehicles[0].mass" in proc.stderr
+
+
+def test_chain_solve_then_reconstruct_from_rest_recovers_the_pre_impact_speeds():
+    """pre-impact -> impact -> rest (solve_to_rest), then the rest poses back
+    to the pre-impact motion (reconstruct_from_rest): the given speeds return."""
+    from impactsym.runout.chain import reconstruct_from_rest, solve_to_rest
+
+    scene = json.loads((ROOT / "examples" / "runout" / "chain_solve.json").read_text())
+    forward = solve_to_rest(scene)
+    for v, out in zip(scene["vehicles"], forward["vehicles"]):
+        v["given"] = v.pop("velocity")
+        v["rest"] = out["rest"]
+    for key in ("restitution", "impulse_ratio", "moment_restitution"):
+        scene["impact"].pop(key)
+    given = [v.pop("given") for v in scene["vehicles"]]
+    back = reconstruct_from_rest(scene)
+    for v, g in zip(back["vehicles"], given):
+        assert v["runout"]["fit"]["converged"]
+        assert math.hypot(v["velocity"][0] - g[0], v["velocity"][1] - g[1]) < 0.01
+
+
+def test_cli_chain_reconstruct(tmp_path):
+    proc = _cli(
+        str(ROOT / "examples" / "runout" / "chain_reconstruct.json"), "--chain", "reconstruct", "--json"
+    )
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(proc.stdout)
+    assert {"speed", "velocity", "runout"} <= set(data["vehicles"][0])
+
+
+def test_linear_separation_sensitivity_matches_a_refit():
+    """d(separation state)/d(rest pose, mu) from the integrated sensitivities
+    against fitting again to a moved rest pose and a changed friction."""
+    import numpy as np
+
+    from impactsym.runout.interval import separation_sensitivity
+
+    scene = _scene()
+    v = scene["vehicles"][0]
+    v["wheels"] = "locked"
+    v["separation"].update(velocity=[9.0, 2.0], yaw_rate=1.0)
+    rest = runout(scene)["vehicles"][0]["rest"]
+    del v["separation"]["velocity"], v["separation"]["yaw_rate"]
+    v["rest"] = rest
+    veh = load_runout(scene).vehicles[0]
+    base = fit_rest(veh)
+    A = separation_sensitivity(veh, base)
+    moved = copy.deepcopy(scene)
+    moved["vehicles"][0]["rest"]["position"][0] += 0.05
+    moved["runout"]["friction"] += 0.01
+    again = fit_rest(load_runout(moved).vehicles[0])
+    predicted = np.array([*base.velocity, base.yaw_rate]) + A @ [0.05, 0.0, 0.0, 0.01]
+    assert np.allclose([*again.velocity, again.yaw_rate], predicted, atol=2e-3)
+
+
+def test_fit_with_a_tyre_mark_direction_at_separation():
+    """The direction of a wheel's mark at separation enters the fit as a fourth
+    residual: consistent with the rest pose it is met and the state recovered;
+    3 deg off, the least-squares fit spreads the misfit over the mark and the
+    rest pose."""
+    scene = _scene()
+    v = scene["vehicles"][0]
+    v["wheels"] = {
+        "front_left": "locked",
+        "front_right": "locked",
+        "rear_left": "rolling",
+        "rear_right": "rolling",
+    }
+    v["separation"].update(velocity=[9.0, 2.0], yaw_rate=1.0)
+    rest = runout(scene)["vehicles"][0]["rest"]
+    psi = math.radians(30.0)
+    rx, ry = 1.1 * math.cos(psi) - 0.75 * math.sin(psi), 1.1 * math.sin(psi) + 0.75 * math.cos(psi)
+    true_mark = math.degrees(math.atan2(2.0 + 1.0 * rx, 9.0 - 1.0 * ry))
+    del v["separation"]["velocity"], v["separation"]["yaw_rate"]
+    v["rest"] = rest
+    v["separation"]["mark_directions"] = {"front_left": true_mark}
+    entry = runout(scene)["vehicles"][0]
+    assert entry["fit"]["converged"]
+    assert entry["fit"]["residual"]["marks"]["front_left"] < 1e-3
+    assert entry["separation"]["velocity"] == pytest.approx([9.0, 2.0], abs=0.01)
+    v["separation"]["mark_directions"] = {"front_left": true_mark + 3.0}
+    off = runout(scene)["vehicles"][0]
+    assert off["fit"]["converged"]
+    assert 0.01 < off["fit"]["residual"]["marks"]["front_left"] < 3.0
+    assert off["fit"]["residual"]["position"] > 1e-3
+
+
+def test_solve_and_reconstruct_commands_chain_through_the_runout():
+    """conventions.md, "Chained": a solve scene with run-out data reports each
+    vehicle's rest; a reconstruct scene with rest poses fits the run-outs first."""
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "impactsym",
+            "solve",
+            str(ROOT / "examples" / "runout" / "chain_solve.json"),
+            "--json",
+        ],
+        capture_output=True,
+        text=True,
+        env=dict(os.environ, PYTHONPATH=str(ROOT)),
+        timeout=300,
+    )
+    assert proc.returncode == 0, proc.stderr
+    solved = json.loads(proc.stdout)
+    assert all(set(v["rest"]) == {"position", "heading"} for v in solved["vehicles"])
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "impactsym",
+            "reconstruct",
+            str(ROOT / "examples" / "runout" / "chain_reconstruct.json"),
+            "--json",
+        ],
+        capture_output=True,
+        text=True,
+        env=dict(os.environ, PYTHONPATH=str(ROOT)),
+        timeout=300,
+    )
+    assert proc.returncode == 0, proc.stderr
+    speeds = [v["speed"] for v in json.loads(proc.stdout)["vehicles"]]
+    assert speeds == pytest.approx([17.0, 8.0], abs=0.01)

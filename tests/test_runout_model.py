@@ -1,0 +1,171 @@
+"""Run-out model: closed forms, the smoothing's effect on the rest pose, bad rows.
+
+Closed forms (conventions.md, run-out): a locked slide stops at v^2/(2 mu g); a
+pure locked spin of a vehicle with its centre of gravity mid-wheelbase turns
+I w^2/(2 mu sum N_i |r_i|); rolling resistance alone stops at v^2/(2 f_r g).
+Tolerances are the smoothing's documented effect (derive/runout.py):
+eps^2/(2a) plus V_STOP eps/a of creep, a the deceleration.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from impactsym.runout import runout_batch
+from impactsym.runout._door import plain
+from impactsym.runout.batch import columns, run_row
+from tests.runout_rows import realistic_row, rows_table
+
+G = 9.80665
+EPS = plain().EPS
+BASE = {
+    "m": 1450.0,
+    "I": 2400.0,
+    "L": 2.7,
+    "a": 1.1,
+    "track": 1.5,
+    "mu": 0.8,
+    "alpha_max": math.radians(10),
+    "f_r": 0.01,
+    "g": G,
+    "x": 1.0,
+    "y": -2.0,
+    "psi": 0.3,
+    "vx": 0.0,
+    "vy": 0.0,
+    "w": 0.0,
+}
+
+
+def _row(state: float, **kw) -> dict:
+    row = dict(BASE, **kw)
+    for k in ("fl", "fr", "rl", "rr"):
+        row.update({f"state_{k}": state, f"brake_{k}": 0.0, f"steer_{k}": 0.0})
+    return row
+
+
+def _one(row, **kw):
+    return run_row(np.array([row[c] for c in columns()]), **kw)
+
+
+@pytest.mark.parametrize("speed", [5.0, 20.0, 35.0])
+def test_locked_slide_stops_at_v2_over_2_mu_g(speed):
+    psi = BASE["psi"]
+    y, t, status, _, _ = _one(_row(1.0, vx=speed * math.cos(psi), vy=speed * math.sin(psi)))
+    assert status == 0
+    expected = speed**2 / (2 * 0.8 * G)
+    assert abs(math.hypot(y[0] - 1.0, y[1] + 2.0) - expected) < 1e-4
+    assert abs(y[2] - psi) < 1e-9  # symmetric: no yaw
+    assert abs(t - speed / (0.8 * G)) < 2e-3
+
+
+@pytest.mark.parametrize("w", [-4.0, 1.5, 6.0])
+def test_pure_locked_spin_turns_I_w2_over_2_mu_sum_N_r(w):
+    row = _row(1.0, a=1.35, w=w)  # cg mid-wheelbase: the wheel forces cancel, the cg stays
+    y, _, status, _, _ = _one(row)
+    radius = math.hypot(1.35, 0.75)
+    expected = 2400.0 * w * w / (2 * 0.8 * 1450.0 * G * radius)  # sum N_i |r_i| = m g |r|
+    assert status == 0
+    assert abs(abs(y[2] - row["psi"]) - expected) < 1e-4  # rad
+    assert math.hypot(y[0] - 1.0, y[1] + 2.0) < 1e-6
+
+
+@pytest.mark.parametrize("speed", [3.0, 10.0])
+def test_rolling_resistance_alone_stops_at_v2_over_2_fr_g(speed):
+    psi = BASE["psi"]
+    y, _, status, _, _ = _one(_row(0.0, vx=speed * math.cos(psi), vy=speed * math.sin(psi)))
+    expected = speed**2 / (2 * 0.01 * G)
+    assert status == 0
+    assert abs(math.hypot(y[0] - 1.0, y[1] + 2.0) - expected) < 1e-3  # documented creep: micrometres
+    assert abs(y[2] - psi) < 1e-9
+
+
+def test_smoothing_moves_the_rest_pose_less_than_1_mm_and_001_deg():
+    """eps against eps/10 (both at a tight tolerance) on random realistic run-outs,
+    the sticking case of seed 7's fifth row included (0.3 mm, 0.005 deg)."""
+    rng = np.random.default_rng(7)
+    for _ in range(12):
+        row = realistic_row(rng)
+        a, _, s1, _, _ = _one(row, tol=1e-10)
+        b, _, s2, _, _ = _one(row, tol=1e-10, eps=EPS / 10)
+        assert s1 == s2 == 0
+        assert math.hypot(a[0] - b[0], a[1] - b[1]) < 1e-3
+        assert abs(math.degrees(a[2] - b[2])) < 0.01
+
+
+def test_sensitivities_match_finite_differences():
+    """d rest/d(vx, vy, w, mu) integrated with the motion against central
+    differences of whole run-outs (a smooth case: all wheels locked)."""
+    row = _row(1.0, vx=12.0, vy=4.0, w=1.5)
+    y, _, _, _, _ = _one(row, sens=True, tol=1e-11)
+    S = y[7:].reshape(6, 4)
+    for j, key in enumerate(("vx", "vy", "w", "mu")):
+        h = 1e-4
+        up, _, _, _, _ = _one(dict(row, **{key: row[key] + h}), tol=1e-11)
+        dn, _, _, _, _ = _one(dict(row, **{key: row[key] - h}), tol=1e-11)
+        fd = (up[:3] - dn[:3]) / (2 * h)
+        assert np.allclose(S[:3, j], fd, rtol=2e-3, atol=2e-3), (key, S[:3, j], fd)
+
+
+def test_bad_rows_get_a_status_and_the_others_are_unaffected():
+    rng = np.random.default_rng(3)
+    rows = [realistic_row(rng) for _ in range(8)]
+    bad = {
+        1: ("m", math.nan, 1),
+        2: ("I", 0.0, 2),
+        3: ("a", 3.5, 20),
+        4: ("mu", -0.1, 21),
+        5: ("state_fl", 0.5, 23),
+        6: ("brake_rr", 1.5, 23),
+    }
+    for i, (key, value, _) in bad.items():
+        rows[i][key] = value
+    rows[7].update(f_r=0.0, vx=5.0 * math.cos(rows[7]["psi"]), vy=5.0 * math.sin(rows[7]["psi"]), w=0.0)
+    for k in ("fl", "fr", "rl", "rr"):
+        rows[7].update({f"state_{k}": 0.0, f"brake_{k}": 0.0, f"steer_{k}": 0.0})
+    out = runout_batch(rows_table(rows))
+    for i, (_, _, code) in bad.items():
+        assert out["status"][i] == code and math.isnan(out["x_rest"][i])
+    assert out["status"][7] == 22  # rolls on without resistance: NOT_STOPPED
+    assert out["status"][0] == 0 and math.isfinite(out["x_rest"][0])
+    alone = runout_batch(rows_table(rows[:1]))
+    assert alone["x_rest"][0] == out["x_rest"][0]
+
+
+def test_batch_refuses_a_missing_or_unknown_column_naming_it():
+    from impactsym.errors import SceneError
+
+    row = _row(1.0, vx=5.0)
+    cols = {k: np.array([v]) for k, v in row.items()}
+    del cols["mu"]
+    with pytest.raises(SceneError, match="^mu: missing column$"):
+        runout_batch(cols)
+    cols = {k: np.array([v]) for k, v in row.items()}
+    cols["muu"] = np.array([0.8])
+    with pytest.raises(SceneError, match="^muu: unknown column"):
+        runout_batch(cols)
+
+
+def test_extreme_rows_run_to_rest_or_get_a_status():
+    """Stress: at rest already, 60 m/s, 20 rad/s, full brake (cap 0), steer 89
+    deg, mu 2, a 5 deg slip angle, a light trailer-like body: every row either
+    stops with finite outputs, or has a status and NaN outputs; never a
+    solved row with NaN."""
+    rows = [
+        _row(1.0),  # at rest
+        _row(0.0, vx=60.0),
+        _row(1.0, w=20.0),
+        _row(0.0, vx=10.0, vy=5.0, w=3.0, mu=2.0, alpha_max=math.radians(5)),
+        _row(0.0, vx=8.0, vy=-8.0, m=300.0, I=150.0),
+    ]
+    rows.append(dict(_row(0.0, vx=12.0, w=1.0), brake_fl=1.0, brake_fr=1.0, steer_rl=math.radians(89)))
+    out = runout_batch(rows_table(rows))
+    assert (out["status"] == 0).all()
+    for key in ("x_rest", "y_rest", "psi_rest", "t", "distance"):
+        assert np.isfinite(out[key]).all(), key
+    assert out["t"][0] == 0.0 and out["x_rest"][0] == BASE["x"] and out["distance"][0] == 0.0
+    # a wheel that is fully braked pushes only along itself: the car still stops
+    assert out["distance"][5] > 0
