@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from impactsym import load_scene, solve
-from impactsym.casefile import used_normal_angle
+from impactsym.scene.casefile import used_normal_angle
 from impactsym.errors import SceneError
 
 # a bar struck square on: the impact points lie along the crush surface's
