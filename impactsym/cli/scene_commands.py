@@ -10,6 +10,7 @@ from ..crash3 import crash3
 from ..inverse import invert
 from ..plot import add_plot_argument, save_plot
 from ..reconstruct import reconstruct
+from ..residue import without_json_residue
 from ..result import json_clean
 from ..single import solve
 from ..uncertainty import cli as uncertainty_cli
@@ -27,7 +28,7 @@ def _add_solve(parser: argparse.ArgumentParser) -> None:
 def _print_result(result, as_json: bool) -> int:
     """Print a result as JSON or as a table; return exit code 0."""
     if as_json:
-        print(json.dumps(json_clean(result.to_json_dict()), indent=2, allow_nan=False))
+        print(json.dumps(json_clean(without_json_residue(result.to_json_dict())), indent=2, allow_nan=False))
     else:
         print(result.table())
     return 0

@@ -64,6 +64,7 @@ from typing import Any
 from .._util import require
 from ..codes import FLAG_ENERGY_CREATED, FLAG_MU_BEYOND_CRITICAL, FLAG_TENSILE_IMPULSE
 from ..crash3 import Crash3Result
+from ..residue import drop_residue, quantity_scales
 from ..result import UNIT_LABELS
 from ..scene import Scene
 from .canvas import _angle, _Canvas
@@ -211,6 +212,12 @@ def _draw(
 
     # velocity scale: drawn length per velocity unit
     k = velocity_scale if velocity_scale else _auto_scale(bodies, size)
+    speeds = [_norm(v) for body in bodies for v in (body.v0, body.v1) if v is not None]
+    rate_scale = quantity_scales(  # rounding residue of a zero is not drawn (impactsym.residue)
+        [("speed", v) for v in speeds] + [("yaw_rate", w) for b in bodies for w in (b.w0, b.w1) if w is not None]
+    )["yaw_rate"]
+    for body in bodies:
+        body.w0, body.w1 = (None if w is None else drop_residue(w, rate_scale) for w in (body.w0, body.w1))
     rates = [abs(w) for body in bodies for w in (body.w0, body.w1) if w is not None]
     wmax = max(rates, default=0.0)
 

@@ -15,6 +15,8 @@ import json
 
 from ..scene import SceneError
 from .propagation import uncertainty
+from ..residue import without_json_residue
+from ..result import json_clean
 
 DEFAULT_DRAWS = 10_000
 
@@ -61,9 +63,8 @@ def run(args: argparse.Namespace, command: str, result, **options) -> int:
 
         save_uncertainty_plot(u, args.plot)
     if args.json:
-        print(
-            json.dumps({**result.to_json_dict(), "uncertainty": u.to_json_dict()}, indent=2, allow_nan=False)
-        )
+        both = without_json_residue({**result.to_json_dict(), "uncertainty": u.to_json_dict()})
+        print(json.dumps(json_clean(both), indent=2, allow_nan=False))
     else:
         print(result.table())
         print()

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from ..batch.quantiles import percentiles
+from ..residue import without_json_residue
 
 __all__ = ["Uncertainty", "Stats", "KEEP", "HISTOGRAM_BINS", "PERCENTILES"]
 
@@ -186,7 +187,11 @@ class Uncertainty:
             "",
             (f"{'output':<{width}}{'nominal':>12}{'mean':>12}{'90 % interval':>26}  largest budget shares"),
         ]
+        shown = ("nominal", "mean", "p5", "p95")  # rounding residue shown as 0 (impactsym.residue)
+        outputs = {p: {k: o[k] for k in shown if o[k] is not None} for p, o in self.outputs.items()}
+        outputs = without_json_residue({"uncertainty": {"outputs": outputs}})["uncertainty"]["outputs"]
         for path, o in self.outputs.items():
+            o = {**o, **outputs[path]}
             top = sorted(self.budget.get(path, {}).items(), key=lambda kv: -abs(kv[1]))[:3]
             interval = f"[{_cell(o['p5'])}, {_cell(o['p95'])}]"
             lines.append(
