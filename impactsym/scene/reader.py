@@ -33,6 +33,7 @@ from .casefile import (
 )
 from .fields import as_choice, as_flag, as_mapping, as_name, require_key
 from .model import CRITICAL, KINDS, MODELS, UNITS, Impact, Scene, Vehicle, pair, uses_yaw
+from .plausibility import implausible
 
 
 def load_scene(source: Scene | Mapping | str | Path, kind: str = "forward") -> Scene:
@@ -195,6 +196,7 @@ def _parse_scene(data: Any, source: Path | None, kind: str) -> Scene:
     warnings = reading.warnings
     if kind in ("forward", "inverse"):
         warnings += _unused_coefficients(impact_data, model)
+    warnings += implausible(leaves, vehicles, units)
     return Scene(
         model, units, impact, vehicles, source, extra, tuple(warnings), kind, leaves, correlations, data
     )
