@@ -39,6 +39,7 @@ def _report(result, args: argparse.Namespace, command: str) -> int:
     ``--uncertainty`` the result with its uncertainty (uncertainty_cli)."""
     if args.uncertainty:
         return uncertainty_cli.run(args, command, result)
+    uncertainty_cli.warn_unused(args)
     if args.plot:
         save_plot(result, args.plot, scene=args.scene)
     return _print_result(result, args.json)
@@ -93,6 +94,7 @@ def _add_crash3(parser: argparse.ArgumentParser) -> None:
 def _run_crash3(args: argparse.Namespace) -> int:
     """CRASH3 delta-V from the vehicles' crush tables; print JSON or a table."""
     result = crash3(args.scene, restitution=args.restitution, energy=args.energy, correction=args.correction)
+    uncertainty_cli.warn_unused(args)
     if args.uncertainty:
         return uncertainty_cli.run(
             args,
