@@ -305,10 +305,26 @@ def _crush_only(data: Mapping, forward_error: SceneError) -> Comparison:
             [w for w in result.warnings if w not in scene.warnings],
         ),
     )
-    reason = f"needs a forward scene (pre-impact motion and impact geometry): {forward_error}"
-    skipped = {name: reason for name in COMPARED_MODELS if name != "crash3"}
+    skipped = {name: _needs(data, name) for name in COMPARED_MODELS if name != "crash3"}
     names = (scene.vehicles[0].name, scene.vehicles[1].name)
     return Comparison(scene.units, names, None, rows, skipped)
+
+
+def _needs(data: Mapping, model: str) -> str:
+    """Why a crush-only scene cannot run ``model``: what the model itself needs
+    and the scene lacks (the pre-impact motion; its preset's coefficients)."""
+    impact = data.get("impact", {}) if isinstance(data.get("impact"), Mapping) else {}
+    vehicles = data.get("vehicles", [])
+    motion = [
+        f"vehicles[{i}].velocity"
+        for i, v in enumerate(vehicles)
+        if isinstance(v, Mapping) and "velocity" not in v and not v.get("fixed")
+    ]
+    coefficients = [f"impact.{key}" for key in PRESETS[model]["required"] if key not in impact]
+    needs = ([", ".join(motion) + " (the pre-impact motion)"] if motion else []) + (
+        [", ".join(coefficients)] if coefficients else []
+    )
+    return "needs " + " and ".join(needs) if needs else "needs a forward scene"
 
 
 def _crash3_energy(result) -> dict[str, float | None]:
