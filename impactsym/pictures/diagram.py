@@ -69,6 +69,7 @@ from ..result import UNIT_LABELS
 from ..scene import Scene
 from .canvas import _angle, _Canvas
 from .crash3 import save_crash3
+from .glyphs import one_glyph_warning
 from .inputs import SceneLike, _add, _norm, _num, _resolve, _scale, _sub
 from .labels import place_labels
 from .layout import _auto_scale, _bodies, _Body, _characteristic_length, _frame
@@ -122,7 +123,8 @@ def scene(
         import matplotlib.pyplot as plt
 
         _, ax = plt.subplots(figsize=(9.0, 6.5), layout="constrained")
-    _draw(ax, the_scene, the_result, position, velocity_scale, legend, title)
+    with one_glyph_warning():
+        _draw(ax, the_scene, the_result, position, velocity_scale, legend, title)
     return ax
 
 
@@ -156,19 +158,20 @@ def save_plot(
     fig = Figure(figsize=(9.0, 6.5), layout="constrained")
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
-    _draw(
-        ax,
-        the_scene,
-        the_result,
-        position,
-        options.pop("velocity_scale", None),
-        options.pop("legend", True),
-        options.pop("title", None),
-    )
-    if options:
-        raise TypeError(f"save_plot: unexpected options {', '.join(sorted(options))}")
-    path = Path(path)
-    fig.savefig(path, dpi=dpi, bbox_inches="tight")
+    with one_glyph_warning():
+        _draw(
+            ax,
+            the_scene,
+            the_result,
+            position,
+            options.pop("velocity_scale", None),
+            options.pop("legend", True),
+            options.pop("title", None),
+        )
+        if options:
+            raise TypeError(f"save_plot: unexpected options {', '.join(sorted(options))}")
+        path = Path(path)
+        fig.savefig(path, dpi=dpi, bbox_inches="tight")
     return path
 
 
