@@ -39,7 +39,8 @@ def test_save_plot_of_an_axes_says_what_to_do():
     import matplotlib
 
     matplotlib.use("Agg")
-    from impactsym.plot import save_plot, sweep as sweep_plot
+    from impactsym.plot import save_plot
+    from impactsym.plot import sweep as sweep_plot
 
     frame = impactsym.sweep(EXAMPLES / "two_car_us.json", e=[0.1, 0.2, 0.3])
     ax = sweep_plot(frame, x="e")
