@@ -439,6 +439,19 @@ def _pdof_label(body: _Body) -> str:
     return f"PDOF {round(clockwise)}° ({clock} o'clock)"  # an int: no "-0°"
 
 
+def shown_beside(value: float, bounds: tuple[float, ...], digits: int = 3) -> str:
+    """``value`` with ``digits`` significant digits, or as many more as it
+    takes not to read as one of ``bounds`` it differs from (a flag raised for
+    e_m = 1.00067 must not be captioned "e_m = 1"); then as few as show it on
+    the same side of that bound."""
+    for places in range(digits, 18):
+        text = f"{value:.{places}g}"
+        shown = float(text)
+        if not any(b != value and (shown == b or (shown > b) != (value > b)) for b in bounds):
+            return text
+    return repr(value)
+
+
 def _title(scene: Scene, result: Any) -> str:
     impact = scene.impact
     name = scene.source.name if scene.source is not None else "scene"
@@ -456,16 +469,16 @@ def _title(scene: Scene, result: Any) -> str:
     )
     if getattr(result, "kind", None) == "reconstruct":
         head = (
-            f"{name}: reconstruction, {scene.units}; Γ = {impact.normal_angle:g}°, implied e = {result.e:.3g}, "
-            f"e_m = {result.e_m:.3g}"
+            f"{name}: reconstruction, {scene.units}; Γ = {impact.normal_angle:g}°, implied e = "
+            f"{shown_beside(result.e, (0.0, 1.0))}, e_m = {shown_beside(result.e_m, (-1.0, 1.0))}"
         )
     if result is None:
         return head
     energy = UNIT_LABELS[scene.units]["energy"]
     parts = []
     mu_value, mu_c = _num(getattr(result, "mu", None)), _num(getattr(result, "mu_c", None))
-    if mu_value is not None:
-        parts.append(f"μ = {mu_value:.3g}")
+    if mu_value is not None:  # digits enough to tell μ from its bounds 0 and μ_c (flag 4)
+        parts.append(f"μ = {shown_beside(mu_value, (0.0,) if mu_c is None else (0.0, mu_c))}")
     if mu_c is not None:
         parts.append(f"μ_c = {mu_c:.3g}")
     loss = _num(getattr(result, "TL", None))
