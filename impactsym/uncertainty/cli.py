@@ -77,7 +77,7 @@ def run(args: argparse.Namespace, command: str, result, **options) -> int:
     if getattr(args, "plot", None):
         from .plot import save_uncertainty_plot
 
-        save_uncertainty_plot(u, args.plot)
+        save_uncertainty_plot(u, args.plot, names=[v.name for v in result.vehicles], units=result.units)
     if args.json:
         both = without_json_residue({**result.to_json_dict(), "uncertainty": u.to_json_dict()})
         print(json.dumps(json_clean(both), indent=2, allow_nan=False))
