@@ -10,7 +10,7 @@ import pytest
 
 import impactsym
 from impactsym.testing.figures import overlapping, text_boxes
-from impactsym.uncertainty_plot import uncertainty_figure
+from impactsym.uncertainty.plot import uncertainty_figure
 
 matplotlib.use("Agg")
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -59,7 +59,7 @@ def test_the_uncertainty_figure_reads_cleanly(command, name, edit, run):
 
 
 def test_save_uncertainty_plot_still_writes_a_file(tmp_path):
-    from impactsym.uncertainty_plot import save_uncertainty_plot
+    from impactsym.uncertainty.plot import save_uncertainty_plot
 
     u = impactsym.uncertainty(EXAMPLES / "reconstruct_intersection_uncertain.json", command="reconstruct",
                               draws=2000, seed=1)

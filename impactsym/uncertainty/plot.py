@@ -12,7 +12,7 @@ import re
 
 import numpy as np
 
-from .result import UNIT_LABELS
+from ..result import UNIT_LABELS
 
 #: Outputs drawn first when present (the answers a reconstructionist reports).
 MAIN = (
