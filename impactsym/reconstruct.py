@@ -221,7 +221,9 @@ def residual_warnings(out: Mapping, values: Mapping, units: str) -> list[str]:
     :data:`RESIDUAL_READING` of the yaw impulses I·|W - w|): the mean M then
     has no meaning (a placeholder final yaw rate, a misplaced impact centre)."""
     M, residual = out["M"], out["M_residual"]
-    reading = RESIDUAL_READING * max(abs(values[f"I{i}"] * (values[f"W{i}"] - values[f"w{i}"])) for i in (1, 2))
+    reading = RESIDUAL_READING * max(
+        abs(values[f"I{i}"] * (values[f"W{i}"] - values[f"w{i}"])) for i in (1, 2)
+    )
     if not math.isfinite(residual) or abs(residual) <= max(abs(M), reading):
         return []
     unit = UNIT_LABELS[units]["moment"]

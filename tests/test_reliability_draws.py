@@ -22,8 +22,20 @@ def test_too_few_draws_for_an_interval_are_refused(draws, capsys):
 
 
 def test_the_minimum_is_accepted_and_documented(capsys):
-    assert main(["reconstruct", str(UNCERTAIN), "--uncertainty", "--draws", str(MIN_INTERVAL_DRAWS),
-                 "--seed", "1"]) == 0
+    assert (
+        main(
+            [
+                "reconstruct",
+                str(UNCERTAIN),
+                "--uncertainty",
+                "--draws",
+                str(MIN_INTERVAL_DRAWS),
+                "--seed",
+                "1",
+            ]
+        )
+        == 0
+    )
     assert "90 % interval" in capsys.readouterr().out
     text = (Path(__file__).resolve().parents[1] / "docs" / "uncertainty.md").read_text()
     assert f"at least {MIN_INTERVAL_DRAWS} draws" in text

@@ -20,10 +20,22 @@ SQUARE_ON = {
     "units": "SI",
     "impact": {"normal_angle": -90.0, "restitution": 0.2, "impulse_ratio": 0.0, "moment_restitution": 0.0},
     "vehicles": [
-        {"name": "a", "mass": 1000, "yaw_inertia": 1500, "velocity": [0, -10], "yaw_rate": 0,
-         "impact_point": [-1, 0]},
-        {"name": "b", "mass": 1200, "yaw_inertia": 1800, "velocity": [0, 0], "yaw_rate": 0,
-         "impact_point": [1, 0]},
+        {
+            "name": "a",
+            "mass": 1000,
+            "yaw_inertia": 1500,
+            "velocity": [0, -10],
+            "yaw_rate": 0,
+            "impact_point": [-1, 0],
+        },
+        {
+            "name": "b",
+            "mass": 1200,
+            "yaw_inertia": 1800,
+            "velocity": [0, 0],
+            "yaw_rate": 0,
+            "impact_point": [1, 0],
+        },
     ],
 }
 
@@ -60,9 +72,7 @@ def test_a_180_case_and_its_mirror_both_solve():
     mirror = copy.deepcopy(data)
     for vehicle in mirror["vehicles"]:
         vehicle["impact_point"][1] *= -1
-    assert solve(data).vehicles[0].velocity[0] == pytest.approx(
-        solve(mirror).vehicles[0].velocity[0]
-    )
+    assert solve(data).vehicles[0].velocity[0] == pytest.approx(solve(mirror).vehicles[0].velocity[0])
 
 
 def test_a_sense_the_geometry_decides_is_still_turned_round():

@@ -24,8 +24,9 @@ def _kind(path):
     return "forward"
 
 
-@pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml")),
-                         ids=lambda p: p.name)
+@pytest.mark.parametrize(
+    "path", sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml")), ids=lambda p: p.name
+)
 def test_no_bundled_example_is_questioned(path):
     scene = load_scene(path, kind=_kind(path))
     assert implausible(scene.leaves, scene.vehicles, scene.units) == []

@@ -23,19 +23,41 @@ IMPORT_NAME = {"dask[distributed]": "dask", "SALib": "SALib", "pyyaml": "yaml"}
 # What the README shows, as command lines run from the checkout (each is quoted
 # from the README's text, so that a new example needs a line here).
 EXAMPLES = [
-    ("impactsym reconstruct examples/reconstruct_intersection_us_casefile.json",
-     ["reconstruct", "examples/reconstruct_intersection_us_casefile.json"]),
-    ("impactsym solve examples/intersection_si.toml --plot docs/scene.png",
-     ["solve", "examples/intersection_si.toml", "--plot", "{tmp}/scene.png"]),
-    ("impactsym compare SCENE [--markdown] [--plot]", ["compare", "examples/models_two_car_us.json", "--plot",
-                                                       "{tmp}/compare.png"]),
-    ("impactsym sweep SCENE --vary e=0:0.4:41", ["sweep", "examples/two_car_us.json", "--vary", "e=0:0.4:41",
-                                                 "-o", "{tmp}/rows.parquet", "--json"]),
-    ("impactsym sample SCENE --dist e=uniform:0:0.3 -n N --seed S",
-     ["sample", "examples/two_car_us.json", "--dist", "e=uniform:0:0.3", "-n", "1000", "--seed", "1"]),
-    ("--uncertainty [--draws N] [--seed S] [--sobol] [--plot OUT.png]",
-     ["reconstruct", "examples/reconstruct_intersection_uncertain.json", "--uncertainty", "--draws", "1000",
-      "--seed", "1", "--sobol", "--plot", "{tmp}/u.png"]),
+    (
+        "impactsym reconstruct examples/reconstruct_intersection_us_casefile.json",
+        ["reconstruct", "examples/reconstruct_intersection_us_casefile.json"],
+    ),
+    (
+        "impactsym solve examples/intersection_si.toml --plot docs/scene.png",
+        ["solve", "examples/intersection_si.toml", "--plot", "{tmp}/scene.png"],
+    ),
+    (
+        "impactsym compare SCENE [--markdown] [--plot]",
+        ["compare", "examples/models_two_car_us.json", "--plot", "{tmp}/compare.png"],
+    ),
+    (
+        "impactsym sweep SCENE --vary e=0:0.4:41",
+        ["sweep", "examples/two_car_us.json", "--vary", "e=0:0.4:41", "-o", "{tmp}/rows.parquet", "--json"],
+    ),
+    (
+        "impactsym sample SCENE --dist e=uniform:0:0.3 -n N --seed S",
+        ["sample", "examples/two_car_us.json", "--dist", "e=uniform:0:0.3", "-n", "1000", "--seed", "1"],
+    ),
+    (
+        "--uncertainty [--draws N] [--seed S] [--sobol] [--plot OUT.png]",
+        [
+            "reconstruct",
+            "examples/reconstruct_intersection_uncertain.json",
+            "--uncertainty",
+            "--draws",
+            "1000",
+            "--seed",
+            "1",
+            "--sobol",
+            "--plot",
+            "{tmp}/u.png",
+        ],
+    ),
     ("impactsym validate [--markdown]", ["validate"]),
 ]
 
@@ -81,14 +103,22 @@ def test_the_first_command_installs_what_the_examples_use(tmp_path):
     installed = _extras(FIRST)
     assert installed, "the README's first command installs only the core"
     kept = _modules(r for extra in installed for r in extras[extra])
-    blocked = _modules(r for name, reqs in extras.items() if name not in ("test", "docs", "derive")
-                       for r in reqs) - kept
+    blocked = (
+        _modules(r for name, reqs in extras.items() if name not in ("test", "docs", "derive") for r in reqs)
+        - kept
+    )
     for quoted, _ in EXAMPLES:
         assert quoted in README, quoted
     runs = [[a.format(tmp=tmp_path) for a in args] for _, args in EXAMPLES]
     env = {**os.environ, "PYTHONPATH": str(ROOT), "IMPACTSYM_BACKGROUND_COMPILE": "0"}
-    run = subprocess.run([sys.executable, "-c", RUNNER, json.dumps(sorted(blocked)), json.dumps(runs)],
-                         cwd=ROOT, env=env, capture_output=True, text=True, timeout=900)
+    run = subprocess.run(
+        [sys.executable, "-c", RUNNER, json.dumps(sorted(blocked)), json.dumps(runs)],
+        cwd=ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
     assert "pip install 'impactsym[" not in run.stderr, run.stderr
     assert run.returncode == 0, run.stderr[-2000:]
     codes = json.loads(run.stdout.split("CODES", 1)[1])

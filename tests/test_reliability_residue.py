@@ -21,13 +21,31 @@ matplotlib.use("Agg")
 NO_ROTATION = {
     "model": "rigid",
     "units": "SI",
-    "impact": {"normal_angle": 30.0, "restitution": {"uniform": [0.1, 0.3]}, "impulse_ratio": 0.0,
-               "moment_restitution": 0.0},
+    "impact": {
+        "normal_angle": 30.0,
+        "restitution": {"uniform": [0.1, 0.3]},
+        "impulse_ratio": 0.0,
+        "moment_restitution": 0.0,
+    },
     "vehicles": [
-        {"name": "a", "mass": 1000, "yaw_inertia": 1500, "velocity": {"speed": 10, "direction": 30},
-         "yaw_rate": 0, "heading": 30, "impact_point": {"distance": 1.5, "angle": 0}},
-        {"name": "b", "mass": 1200, "yaw_inertia": 1800, "velocity": [0, 0], "yaw_rate": 0, "heading": 30,
-         "impact_point": {"distance": 2, "angle": 180}},
+        {
+            "name": "a",
+            "mass": 1000,
+            "yaw_inertia": 1500,
+            "velocity": {"speed": 10, "direction": 30},
+            "yaw_rate": 0,
+            "heading": 30,
+            "impact_point": {"distance": 1.5, "angle": 0},
+        },
+        {
+            "name": "b",
+            "mass": 1200,
+            "yaw_inertia": 1800,
+            "velocity": [0, 0],
+            "yaw_rate": 0,
+            "heading": 30,
+            "impact_point": {"distance": 2, "angle": 180},
+        },
     ],
 }
 RESIDUE_TEXT = re.compile(r"[0-9]e-1[0-9]|-0\.0\b|-0(?![.0-9])")
@@ -46,8 +64,13 @@ def test_the_scene_really_has_residue():
 
 
 @pytest.mark.parametrize(
-    "extra", [[], ["--json"], ["--uncertainty", "--draws", "200", "--seed", "1"],
-              ["--uncertainty", "--draws", "200", "--seed", "1", "--json"]],
+    "extra",
+    [
+        [],
+        ["--json"],
+        ["--uncertainty", "--draws", "200", "--seed", "1"],
+        ["--uncertainty", "--draws", "200", "--seed", "1", "--json"],
+    ],
     ids=["table", "json", "uncertainty-table", "uncertainty-json"],
 )
 def test_commands_print_residue_as_zero(scene_file, capsys, extra):

@@ -82,7 +82,9 @@ def test_sigkill_during_a_sweep_then_the_next_run_cleans_up(tmp_path):
     assert list(tmp_path.glob(f"{SPILL_PREFIX}*"))  # left behind by the killed run
     run = subprocess.run(
         [sys.executable, "-m", "impactsym", "sweep", str(SCENE), "--vary", "e=0.1:0.3:3"],
-        env=env, capture_output=True, text=True,
+        env=env,
+        capture_output=True,
+        text=True,
     )
     assert run.returncode == 0, run.stderr
     assert not list(tmp_path.glob(f"{SPILL_PREFIX}*"))

@@ -61,7 +61,8 @@ def test_the_uncertainty_figure_reads_cleanly(command, name, edit, run):
 def test_save_uncertainty_plot_still_writes_a_file(tmp_path):
     from impactsym.uncertainty.plot import save_uncertainty_plot
 
-    u = impactsym.uncertainty(EXAMPLES / "reconstruct_intersection_uncertain.json", command="reconstruct",
-                              draws=2000, seed=1)
+    u = impactsym.uncertainty(
+        EXAMPLES / "reconstruct_intersection_uncertain.json", command="reconstruct", draws=2000, seed=1
+    )
     save_uncertainty_plot(u, tmp_path / "u.png")
     assert (tmp_path / "u.png").stat().st_size > 10_000

@@ -32,7 +32,11 @@ _TO_SI = {
 RANGES: dict[str, tuple[float, str, str]] = {
     # the road limits (EU 40 t, US 80,000 lb = 36 t): 2,900 slug (42 t) is a
     # 2,900 lb car's weight given as its mass
-    "mass": (40_000.0, "kg", "a weight given as a mass (in US units lb is a weight; mass is lb/32.174 slug)?"),
+    "mass": (
+        40_000.0,
+        "kg",
+        "a weight given as a mass (in US units lb is a weight; mass is lb/32.174 slug)?",
+    ),
     # a spinning car reaches about 5 rad/s (300 deg/s)
     "rate": (10.0, "rad/s", "a yaw rate in deg/s given as rad/s?"),
     # 100 m/s = 360 km/h = 224 mph: faster than any vehicle in road traffic
@@ -45,8 +49,10 @@ RANGES: dict[str, tuple[float, str, str]] = {
 #: Smallest plausible mass [kg]: below it, a mass in tonnes (1.5 for 1500 kg).
 SMALLEST_MASS = 50.0
 
-_SHOWN = {"SI": {"mass": "kg", "length": "m", "speed": "m/s", "crush_length": "m", "rate": "rad/s"},
-          "US": {"mass": "slug", "length": "ft", "speed": "ft/s", "crush_length": "in", "rate": "rad/s"}}
+_SHOWN = {
+    "SI": {"mass": "kg", "length": "m", "speed": "m/s", "crush_length": "m", "rate": "rad/s"},
+    "US": {"mass": "slug", "length": "ft", "speed": "ft/s", "crush_length": "in", "rate": "rad/s"},
+}
 
 
 def implausible(leaves: Mapping[str, Any], vehicles: Sequence[Any], units: str) -> list[str]:
@@ -64,7 +70,10 @@ def _range_warnings(leaves, vehicles, units) -> list[str]:
     values = [(p, d, v) for p, d, v in values if d in RANGES and d != "speed"]
     for index, vehicle in enumerate(vehicles):
         where = f"vehicles[{index}]"
-        for key, vector in (("velocity", vehicle.velocity), ("final_velocity", vehicle.extra.get("final_velocity"))):
+        for key, vector in (
+            ("velocity", vehicle.velocity),
+            ("final_velocity", vehicle.extra.get("final_velocity")),
+        ):
             if vector is not None:
                 values.append((f"{where}.{key}", "speed", math.hypot(*vector)))
         values.append((f"{where}.impact_point", "length", math.hypot(*vehicle.impact_point)))
@@ -126,7 +135,8 @@ def crush_energy_warning(crush_energy: float, scene: Any) -> list[str]:
     none): the crush stiffness (A, B) or depths are too large, or the speeds
     too small."""
     kinetic = sum(
-        0.5 * v.mass * (v.velocity[0] ** 2 + v.velocity[1] ** 2) + 0.5 * (v.yaw_inertia or 0.0) * v.yaw_rate**2
+        0.5 * v.mass * (v.velocity[0] ** 2 + v.velocity[1] ** 2)
+        + 0.5 * (v.yaw_inertia or 0.0) * v.yaw_rate**2
         for v in scene.vehicles
         if not v.fixed
     )

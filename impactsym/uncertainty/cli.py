@@ -56,11 +56,14 @@ def warn_unused(args: argparse.Namespace) -> None:
     """Say on stderr which uncertainty options were given without ``--uncertainty``
     (they are read only with it)."""
     given = [
-        name for name, value in (("--draws", args.draws), ("--seed", args.seed), ("--sobol", args.sobol or None))
+        name
+        for name, value in (("--draws", args.draws), ("--seed", args.seed), ("--sobol", args.sobol or None))
         if value is not None
     ]
     if given and not args.uncertainty:
-        print(f"impactsym: warning: {', '.join(given)} ignored: read only with --uncertainty", file=sys.stderr)
+        print(
+            f"impactsym: warning: {', '.join(given)} ignored: read only with --uncertainty", file=sys.stderr
+        )
 
 
 def run(args: argparse.Namespace, command: str, result, **options) -> int:
