@@ -20,7 +20,7 @@ from .batch import run_columns
 from .codes import describe_flags, describe_status
 from .result import UNIT_LABELS, json_number, road_speed_rows, table_cell, without_residue
 from .scene import Scene, SceneError, load_scene
-from .single import overflow_error
+from .single import overflow_error, turned_round_note
 
 OUTPUTS = _kernels.FAMILY_OUTPUTS["reconstruct"]
 
@@ -171,6 +171,7 @@ def reconstruct(scene: Scene | Mapping | str | Path) -> Reconstruction:
     if out["status"] != 0:
         raise overflow_error(scene, out["status"]) or SceneError(
             f"cannot reconstruct the scene: {describe_status(out['status'])}"
+            + turned_round_note(scene, out["status"])
         )
     vehicles = tuple(_vehicle(v, out, values, i) for i, v in enumerate(scene.vehicles, 1))
     scalars = {

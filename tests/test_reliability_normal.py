@@ -9,6 +9,7 @@ import copy
 import numpy as np
 import pytest
 
+import impactsym
 from impactsym import load_scene, solve
 from impactsym.scene.casefile import used_normal_angle
 from impactsym.errors import SceneError
@@ -112,3 +113,22 @@ def test_turned_normal_refused_says_why():
     text = str(caught.value)
     assert "turned round" in text and "centres of gravity" in text
     assert "0 deg" in text and "180 deg" in text
+
+
+def test_turned_normal_refused_by_reconstruct_says_why():
+    import json
+    from pathlib import Path
+
+    data = json.loads(
+        (Path(__file__).resolve().parents[1] / "examples" / "reconstruct_two_car_si.json").read_text()
+    )
+    first, second = (v["impact_point"] for v in data["vehicles"])
+    data["vehicles"][0]["impact_point"], data["vehicles"][1]["impact_point"] = second, first
+    with pytest.raises(SceneError) as caught:
+        impactsym.reconstruct(data)
+    assert "turned round" in str(caught.value) and "-30 deg" in str(caught.value)
+
+
+def test_compare_keeps_an_undecided_normal():
+    comparison = impactsym.compare(_with(-90.0))
+    assert {"brach", "particle"} <= {row.model for row in comparison.rows}

@@ -104,3 +104,16 @@ def test_the_rule_keeps_small_true_values():
     assert path_quantity("energy_loss.total") == "energy" and path_quantity("flags") is None
     kept = without_json_residue({"energy_loss": {"total": 3e-20}, "other": 1e-20})
     assert kept == {"energy_loss": {"total": 3e-20}, "other": 1e-20}  # its own scale; unknown keys untouched
+
+
+def test_compare_shows_residue_as_zero(tmp_path, capsys):
+    data = json.loads(json.dumps(NO_ROTATION))
+    data["impact"]["restitution"] = 0.2
+    path = tmp_path / "plain.json"
+    path.write_text(json.dumps(data))
+    assert main(["compare", str(path)]) == 0
+    table = capsys.readouterr().out
+    assert "-0.00" not in table and not RESIDUE_TEXT.search(table)
+    assert main(["compare", str(path), "--json"]) == 0
+    models = json.loads(capsys.readouterr().out)["models"]
+    assert all(v["yaw_rate"] in (0.0, None) for m in models for v in m["vehicles"])
