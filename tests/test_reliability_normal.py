@@ -11,8 +11,8 @@ import pytest
 
 import impactsym
 from impactsym import load_scene, solve
-from impactsym.scene.casefile import used_normal_angle
 from impactsym.errors import SceneError
+from impactsym.scene.casefile import used_normal_angle
 
 # a bar struck square on: the impact points lie along the crush surface's
 # tangent, so n·(r1 - r2) = 0 exactly and only rounding of cos(Γ) decides

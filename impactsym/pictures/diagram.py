@@ -217,7 +217,8 @@ def _draw(
     k = velocity_scale if velocity_scale else _auto_scale(bodies, size)
     speeds = [_norm(v) for body in bodies for v in (body.v0, body.v1) if v is not None]
     rate_scale = quantity_scales(  # rounding residue of a zero is not drawn (impactsym.residue)
-        [("speed", v) for v in speeds] + [("yaw_rate", w) for b in bodies for w in (b.w0, b.w1) if w is not None]
+        [("speed", v) for v in speeds]
+        + [("yaw_rate", w) for b in bodies for w in (b.w0, b.w1) if w is not None]
     )["yaw_rate"]
     for body in bodies:
         body.w0, body.w1 = (None if w is None else drop_residue(w, rate_scale) for w in (body.w0, body.w1))
