@@ -99,14 +99,17 @@ def physics_flags(energy_parts, work_terms, mu_used=mu_used, restitution=None):
     sum of |work terms| (|Pn·gn| + |Pt·gt| (+ |M·wr|)) the parts are built from.
     Tensile normal impulse: Pn ≥ 0 (a compressive impulse on vehicle 1 points
     along -n). μ beyond critical: μ not between 0 and μ_c (either sign), by
-    more than ROUNDING·|μ_c|. With `restitution` (a kernel that takes e):
+    more than ROUNDING·(1 + |μ_c|) (an absolute floor for bounds near 0). With `restitution` (a kernel that takes e):
     e outside [0, 1], which the equations solve but no collision has (e < 0
     leaves the vehicles moving into each other, e > 1 creates energy).
     """
     tolerances = Block(
         (
             (tol_energy, ROUNDING * sum(sp.Abs(a * b) for a, b in work_terms)),
-            (tol_mu, ROUNDING * sp.Abs(mu_c)),
+            # μ and μ_c are ratios of an impulse to Pn: each is rounded on the
+            # scale of the impulses, so absolutely by about ROUNDING·(1 + |μ_c|)
+            # however small the ratio (μ = -3e-16 beside μ_c = -1.75e-16 is 0).
+            (tol_mu, ROUNDING * (1 + sp.Abs(mu_c))),
         ),
         equation="tolerances of the physics flags (conventions.md)",
     )

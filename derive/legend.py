@@ -65,7 +65,7 @@ LEGEND = {
     "cd": "(r1 - r2) x P [N m s]",
     "s": "relative yaw rate at separation if there were no moment impulse [rad/s]",
     "tol_energy": "rounding tolerance of the energy flags: 2^-48 sum |work terms| [J]",
-    "tol_mu": "rounding tolerance of the impulse-ratio flag: 2^-48 |mu_c|",
+    "tol_mu": "rounding tolerance of the impulse-ratio flag: 2^-48 (1 + |mu_c|)",
     "one_minus_e": "1 - e, kept as one rounded factor",
     "B": "bracket of the energy-loss formula (seed eq 17 generalised)",
     "P_abs": "|P|, magnitude of the impulse [N s]",

@@ -35,6 +35,7 @@ from . import _kernels
 from ._kernels import PRESETS
 from ._util import require
 from .crash3 import crash3
+from .residue import drop_residue, quantity_scales
 from .result import UNIT_LABELS, Result
 from .scene import Scene, SceneError, load_scene, scene_data, uses_yaw
 from .scene.fields import as_mapping
@@ -135,11 +136,16 @@ class Comparison:
             headers += [f"{name}: V [{v}] / dir", f"W [{w}]", f"|dV| [{v}]"]
         headers += ["TL %", "TLn %", "TLt %", "TLm %"]
         body = []
+        motion = [v for row in self.rows for v in row.vehicles]
+        rate = quantity_scales(  # rounding residue of a zero yaw rate shown as 0 (impactsym.residue)
+            [("speed", v.speed or 0.0) for v in motion] + [("yaw_rate", v.yaw_rate or 0.0) for v in motion]
+        )["yaw_rate"]
         for row in self.rows:
             cells = [row.model]
             for veh in row.vehicles:
                 speed = "n/a" if veh.speed is None else f"{veh.speed:.2f} / {veh.direction:.1f}°"
-                cells += [speed, _cell(veh.yaw_rate, ".2f"), _cell(veh.delta_v_magnitude, ".2f")]
+                yaw = None if veh.yaw_rate is None else drop_residue(veh.yaw_rate, rate)
+                cells += [speed, _cell(yaw, ".2f"), _cell(veh.delta_v_magnitude, ".2f")]
             cells += [_cell(row.energy_percent[part], ".1f") for part in _ENERGY_PARTS]
             body.append(cells)
         return headers, body
@@ -305,10 +311,26 @@ def _crush_only(data: Mapping, forward_error: SceneError) -> Comparison:
             [w for w in result.warnings if w not in scene.warnings],
         ),
     )
-    reason = f"needs a forward scene (pre-impact motion and impact geometry): {forward_error}"
-    skipped = {name: reason for name in COMPARED_MODELS if name != "crash3"}
+    skipped = {name: _needs(data, name) for name in COMPARED_MODELS if name != "crash3"}
     names = (scene.vehicles[0].name, scene.vehicles[1].name)
     return Comparison(scene.units, names, None, rows, skipped)
+
+
+def _needs(data: Mapping, model: str) -> str:
+    """Why a crush-only scene cannot run ``model``: what the model itself needs
+    and the scene lacks (the pre-impact motion; its preset's coefficients)."""
+    impact = data.get("impact", {}) if isinstance(data.get("impact"), Mapping) else {}
+    vehicles = data.get("vehicles", [])
+    motion = [
+        f"vehicles[{i}].velocity"
+        for i, v in enumerate(vehicles)
+        if isinstance(v, Mapping) and "velocity" not in v and not v.get("fixed")
+    ]
+    coefficients = [f"impact.{key}" for key in PRESETS[model]["required"] if key not in impact]
+    needs = ([", ".join(motion) + " (the pre-impact motion)"] if motion else []) + (
+        [", ".join(coefficients)] if coefficients else []
+    )
+    return "needs " + " and ".join(needs) if needs else "needs a forward scene"
 
 
 def _crash3_energy(result) -> dict[str, float | None]:

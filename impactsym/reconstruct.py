@@ -20,7 +20,7 @@ from .batch import run_columns
 from .codes import describe_flags, describe_status
 from .result import UNIT_LABELS, json_number, road_speed_rows, table_cell, without_residue
 from .scene import Scene, SceneError, load_scene
-from .single import overflow_error
+from .single import overflow_error, turned_round_note
 
 OUTPUTS = _kernels.FAMILY_OUTPUTS["reconstruct"]
 
@@ -171,6 +171,7 @@ def reconstruct(scene: Scene | Mapping | str | Path) -> Reconstruction:
     if out["status"] != 0:
         raise overflow_error(scene, out["status"]) or SceneError(
             f"cannot reconstruct the scene: {describe_status(out['status'])}"
+            + turned_round_note(scene, out["status"])
         )
     vehicles = tuple(_vehicle(v, out, values, i) for i, v in enumerate(scene.vehicles, 1))
     scalars = {
@@ -181,7 +182,10 @@ def reconstruct(scene: Scene | Mapping | str | Path) -> Reconstruction:
         units=scene.units,
         vehicles=vehicles,
         flags=out["flags"],
-        warnings=describe_flags(out["flags"]) + moment_warnings(out["e_m"]) + list(scene.warnings),
+        warnings=describe_flags(out["flags"])
+        + moment_warnings(out["e_m"])
+        + residual_warnings(out, values, scene.units)
+        + list(scene.warnings),
         **scalars,
     )
 
@@ -203,6 +207,31 @@ def moment_warnings(e_m: float) -> list[str]:
         f"the implied moment restitution e_m = {e_m:.6g} is outside [{low:g}, {high:g}]: "
         "the final relative yaw rate exceeds the initial one, which creates rotational "
         "energy (TLm < 0); check the yaw rates, headings and impact centre"
+    ]
+
+
+#: The fraction of the yaw impulses I·|W - w| that the given yaw rates, read to
+#: two or three digits, can explain: a moment residual below it is the data's
+#: rounding, not an inconsistency.
+RESIDUAL_READING = 0.01
+
+
+def residual_warnings(out: Mapping, values: Mapping, units: str) -> list[str]:
+    """A warning when the two angular-impulse equations disagree by more than
+    the moment impulse itself, |M_residual| > |M| (and by more than
+    :data:`RESIDUAL_READING` of the yaw impulses I·|W - w|): the mean M then
+    has no meaning (a placeholder final yaw rate, a misplaced impact centre)."""
+    M, residual = out["M"], out["M_residual"]
+    reading = RESIDUAL_READING * max(
+        abs(values[f"I{i}"] * (values[f"W{i}"] - values[f"w{i}"])) for i in (1, 2)
+    )
+    if not math.isfinite(residual) or abs(residual) <= max(abs(M), reading):
+        return []
+    unit = UNIT_LABELS[units]["moment"]
+    return [
+        f"the two angular-impulse equations disagree by moment_residual = {residual:.4g} {unit}, more "
+        f"than the moment impulse M = {M:.4g} {unit} itself: the yaw rates and the impact centre are "
+        "not consistent; check vehicles[].final_yaw_rate (a placeholder?) and vehicles[].impact_point"
     ]
 
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from .codes import describe_flags
+from .residue import RESIDUE, drop_residue
 from .scene import Scene, uses_yaw
 
 __all__ = [
@@ -272,10 +273,11 @@ def table_cell(value: float) -> str:
     return f"{value + 0.0:.6g}"
 
 
-#: In a table (never in JSON or the API), a value smaller than this fraction
-#: of the largest magnitude printed in the same unit is shown as 0: it is
+#: In a table (and ``--json``: :mod:`impactsym.residue`; never the API), a value
+#: smaller than this fraction of the largest magnitude printed in the same unit
+#: (yaw rates: at least the speeds per unit length) is shown as 0: it is
 #: rounding residue of a zero (7.3e-16 m/s beside 50 m/s), not a result.
-TABLE_RESIDUE = 1e-12
+TABLE_RESIDUE = RESIDUE
 
 
 def without_residue(rows: list[tuple]) -> list[tuple]:
@@ -283,15 +285,22 @@ def without_residue(rows: list[tuple]) -> list[tuple]:
     float below :data:`TABLE_RESIDUE` times the largest finite magnitude among
     the rows of the same unit (the ``[m/s]`` that ends the label; rows without
     one, such as ratios, form one group)."""
-    scales: dict[str, float] = {}
+    scales: dict[str, float] = {"": 1.0}  # ratios: scale 1 (impactsym.residue)
     for label, *values in rows:
         unit = _unit_of(label)
         scales[unit] = max([scales.get(unit, 0.0)] + [abs(v) for v in values if _is_float(v)])
+    # yaw rates and moments: at least the speeds (impulses) per unit length
+    speed = max(scales.get(f"{u['velocity']}]", 0.0) for u in UNIT_LABELS.values())
+    impulse = max(scales.get(f"{u['impulse']}]", 0.0) for u in UNIT_LABELS.values())
+    floors = {"rad/s]": speed, "deg/s]": math.degrees(speed)}
+    floors.update({f"{u['moment']}]": impulse for u in UNIT_LABELS.values()})
     return [
         (
             label,
             *(
-                0.0 if _is_float(v) and abs(v) < TABLE_RESIDUE * scales[_unit_of(label)] else v
+                drop_residue(v, max(scales[_unit_of(label)], floors.get(_unit_of(label), 0.0)))
+                if _is_float(v)
+                else v
                 for v in values
             ),
         )

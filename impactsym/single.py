@@ -12,7 +12,7 @@ from .codes import describe_status
 from .result import Result
 from .scene import Scene, SceneError, load_scene
 
-__all__ = ["SAFE_MAGNITUDE", "overflow_error", "solve", "status_reason"]
+__all__ = ["SAFE_MAGNITUDE", "overflow_error", "solve", "status_reason", "turned_round_note"]
 
 #: Magnitudes (scene units) within which the closed forms stay finite: they
 #: multiply and divide at most a few inputs, and (1e100)^3 = 1e300 < 1.8e308.
@@ -35,8 +35,26 @@ def solve(scene: Scene | Mapping | str | Path) -> Result:
     model, critical, values = scene.to_inputs()
     out = _kernels.solve_one(model, critical, values)
     if out["status"] != 0:
-        raise overflow_error(scene, out["status"]) or SceneError(status_reason(out["status"]))
+        raise overflow_error(scene, out["status"]) or SceneError(
+            status_reason(out["status"]) + turned_round_note(scene, out["status"])
+        )
     return Result.from_kernel(scene, out)
+
+
+def turned_round_note(scene: Scene, status: int) -> str:
+    """For a scene refused as not approaching after its normal was turned
+    round (conventions: n·(r1 - r2) > 0 is used), why it was turned and what
+    that means; "" otherwise."""
+    leaf = scene.leaves.get("impact.normal_angle")
+    if status != STATUS_NOT_APPROACHING or leaf is None or leaf.nominal == scene.impact.normal_angle:
+        return ""
+    return (
+        f"; impact.normal_angle = {leaf.nominal:g} deg was turned round to "
+        f"{scene.impact.normal_angle:g} deg because the impact points put the centres of gravity "
+        "on the other sides (vehicle 2's behind vehicle 1's along the normal as given), and with "
+        "the turned normal the vehicles separate; check the impact points (vectors from each "
+        "centre of gravity to the impact centre) as well as the angle"
+    )
 
 
 def overflow_error(scene: Scene, status: int) -> SceneError | None:

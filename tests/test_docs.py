@@ -74,7 +74,7 @@ def test_getting_started_has_the_readme_commands():
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     page = (DOCS / "getting-started.md").read_text(encoding="utf-8")
     install, tests = _fenced_bash(readme)[:2]
-    assert "pip install -e ." in install and "pytest" in tests
+    assert "pip install -e " in install and "pytest" in tests
     assert install in _fenced_bash(page)
     assert tests in _fenced_bash(page)
 

@@ -8,7 +8,6 @@ Checked on the figure ``save_plot`` writes (9 x 6.5 in, constrained layout,
 
 from __future__ import annotations
 
-from itertools import combinations
 from pathlib import Path as FilePath
 
 import matplotlib
@@ -21,6 +20,7 @@ from matplotlib.text import Text
 
 import impactsym
 from impactsym import plot
+from impactsym.testing.figures import overlapping
 
 matplotlib.use("Agg")
 EXAMPLES = FilePath(__file__).resolve().parent.parent / "examples"
@@ -54,8 +54,7 @@ def _drawn(make, path):
 def test_no_two_texts_overlap_and_none_lies_on_an_arrow_or_an_outline(make, path):
     ax, texts = _drawn(make, path)
     assert len(texts) >= 4  # vehicle names, n, and the result's labels are there to check
-    overlapping = [(a, b) for (a, box_a), (b, box_b) in combinations(texts, 2) if box_a.overlaps(box_b)]
-    assert not overlapping
+    assert not overlapping(texts)
     arrows = [p for p in ax.patches if isinstance(p, FancyArrowPatch)]
     assert len(arrows) >= 3
     outlines = [

@@ -20,6 +20,7 @@ import numpy as np
 from .. import _kernels
 from .._util import require
 from ..scene import CRITICAL, load_scene, show_value
+from .resources import check_axis
 from .solve import solve_batch
 
 __all__ = [
@@ -183,6 +184,8 @@ class GridPlan(_Plan):
         kernels = base.kernel_names(values)
         constants, names, varied, shown, axes = dict(base.constants), [], [], [], []
         for name, kernel in zip(values, kernels):
+            if np.ndim(values[name]) == 1:
+                check_axis(name, len(values[name]))  # before its copies are made
             given = _grid_values(name, kernel, values[name])
             if np.ndim(given) == 0:
                 constants[kernel] = _to_kernel_units(name, given)

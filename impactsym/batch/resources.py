@@ -20,7 +20,16 @@ import shutil
 import tempfile
 from pathlib import Path
 
-__all__ = ["DISK_FRACTION", "MEMORY_FRACTION", "available_memory", "check_disk", "check_memory", "size"]
+__all__ = [
+    "AXIS_COPIES",
+    "DISK_FRACTION",
+    "MEMORY_FRACTION",
+    "available_memory",
+    "check_axis",
+    "check_disk",
+    "check_memory",
+    "size",
+]
 
 #: The largest share of the available memory an in-memory result may take.
 MEMORY_FRACTION = 0.5
@@ -28,6 +37,10 @@ MEMORY_FRACTION = 0.5
 DISK_FRACTION = 0.9
 #: Bytes of one float64 value.
 VALUE_BYTES = 8
+#: Copies of a sweep axis alive while a plan is built (the values as given, as
+#: float64, in kernel units): a one-axis grid of N points holds 3·8·N bytes
+#: before its first row, whatever the chunk size.
+AXIS_COPIES = 3
 
 
 def available_memory() -> int | None:
@@ -72,6 +85,20 @@ def check_memory(rows: int, values_per_row: int, what: str) -> None:
             f"{what}: {rows:,} rows need about {size(need)} in memory, more than half of the "
             f"{size(available)} available; write the rows to a file chunk by chunk (-o "
             "rows.parquet; out= in the API), or use fewer points"
+        )
+
+
+def check_axis(name: str, count: int) -> None:
+    """ValueError, before an axis of ``count`` values is built, when its
+    :data:`AXIS_COPIES` copies exceed `MEMORY_FRACTION` of the available memory
+    (a sweep ``--vary e=0:1:1000000000`` is 24 GB of axis before any row)."""
+    need = AXIS_COPIES * count * VALUE_BYTES
+    available = available_memory()
+    if available is not None and need > MEMORY_FRACTION * available:
+        raise ValueError(
+            f"{name}: {count:,} values need about {size(need)} in memory to build the axis, more "
+            f"than half of the {size(available)} available; use fewer points (or several shorter "
+            "sweeps)"
         )
 
 

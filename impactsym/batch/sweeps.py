@@ -43,7 +43,6 @@ streaming percentiles in `impactsym.batch.quantiles`, and the dask executor in
 from __future__ import annotations
 
 import sys
-import tempfile
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 
@@ -56,6 +55,7 @@ from .plans import BLOCK, DISTRIBUTIONS, GridPlan, SamplePlan, check_outputs, fr
 from .quantiles import InMemory, StreamSummary, check_q, counts, summary_frame
 from .resources import check_disk, check_memory
 from .sinks import sink, write_frame, writing
+from .spill import spill_folder
 
 __all__ = [
     "sweep",
@@ -256,7 +256,7 @@ def summarize(
     frames = _frames(plan, engine, chunk_size)
     writer = sink(out, plan.repeated)
     frames = _with_progress(frames, plan.rows, progress)
-    with tempfile.TemporaryDirectory(prefix="impactsym-summary-") as spill:
+    with spill_folder() as spill:  # stale folders of killed runs removed first
         summary = StreamSummary(columns, Path(spill))
         try:
             with writing(writer):

@@ -8,6 +8,7 @@ import argparse
 import io
 import os
 import sys
+import warnings
 from contextlib import suppress
 
 from .._version import __version__
@@ -96,7 +97,8 @@ def main(argv: list[str] | None = None) -> int:
     130 interrupted by Ctrl-C; a reader that stops reading, as ``| head``
     does, ends the command quietly with 1)."""
     try:
-        with terminate_as_exit():
+        with terminate_as_exit(), warnings.catch_warnings():
+            warnings.showwarning = _one_line_warning  # no source paths on a terminal
             args = build_parser().parse_args(argv)
             code = COMMANDS[args.command].run(args)
             sys.stdout.flush()  # a closed pipe shows here, not at interpreter exit
@@ -117,6 +119,11 @@ def main(argv: list[str] | None = None) -> int:
         return _fail(f"{exc.filename}: {exc.strerror}" if exc.filename else str(exc))
     except SystemExit as exc:
         return exc.code if isinstance(exc.code, int) else 0
+
+
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A warning from the library as one line on stderr, without its source."""
+    print(f"{PROG}: warning: {message}", file=file or sys.stderr)
 
 
 def run() -> None:

@@ -10,6 +10,7 @@ from ..crash3 import crash3
 from ..inverse import invert
 from ..plot import add_plot_argument, save_plot
 from ..reconstruct import reconstruct
+from ..residue import without_json_residue
 from ..result import json_clean
 from ..runout import cli as runout_cli
 from ..single import solve
@@ -28,7 +29,7 @@ def _add_solve(parser: argparse.ArgumentParser) -> None:
 def _print_result(result, as_json: bool) -> int:
     """Print a result as JSON or as a table; return exit code 0."""
     if as_json:
-        print(json.dumps(json_clean(result.to_json_dict()), indent=2, allow_nan=False))
+        print(json.dumps(json_clean(without_json_residue(result.to_json_dict())), indent=2, allow_nan=False))
     else:
         print(result.table())
     return 0
@@ -39,6 +40,7 @@ def _report(result, args: argparse.Namespace, command: str) -> int:
     ``--uncertainty`` the result with its uncertainty (uncertainty_cli)."""
     if args.uncertainty:
         return uncertainty_cli.run(args, command, result)
+    uncertainty_cli.warn_unused(args)
     if args.plot:
         save_plot(result, args.plot, scene=args.scene)
     return _print_result(result, args.json)
@@ -97,6 +99,7 @@ def _add_crash3(parser: argparse.ArgumentParser) -> None:
 def _run_crash3(args: argparse.Namespace) -> int:
     """CRASH3 delta-V from the vehicles' crush tables; print JSON or a table."""
     result = crash3(args.scene, restitution=args.restitution, energy=args.energy, correction=args.correction)
+    uncertainty_cli.warn_unused(args)
     if args.uncertainty:
         return uncertainty_cli.run(
             args,

@@ -8,6 +8,7 @@ import json
 
 import numpy as np
 
+from ..batch.resources import check_axis
 from ..batch.sweeps import (
     CHUNK_SIZE,
     PERCENTILES,
@@ -100,6 +101,8 @@ def _parse_vary(text: str):
         start, stop = (_number(part, option) for part in parts[:2])
         if not (np.isfinite(start) and np.isfinite(stop)):
             raise UsageError(f"{option}: START and STOP must be finite numbers")
+        with _api_errors():
+            check_axis(name, int(parts[2]))  # before the axis is built
         return name, np.linspace(start, stop, int(parts[2]))
     if "," in spec:
         return name, [_grid_value(part.strip(), option) for part in spec.split(",")]

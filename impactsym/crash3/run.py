@@ -9,6 +9,7 @@ from pathlib import Path
 
 from .. import _kernels
 from ..scene import Scene, SceneError, Vehicle, load_scene, scene_data
+from ..scene.plausibility import crush_energy_warning
 from ..single import solve
 from .crush import (
     _capped,
@@ -73,6 +74,7 @@ def crash3(
     warnings = (
         _capped(crush, energies, options.correction)
         + _warnings(vehicles, crush, implied)
+        + crush_energy_warning(values["E"], parsed)
         + list(parsed.warnings)
     )
     return Crash3Result(parsed.units, options, vehicles, values["E"], out["P"], warnings)

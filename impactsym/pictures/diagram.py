@@ -64,10 +64,12 @@ from typing import Any
 from .._util import require
 from ..codes import FLAG_ENERGY_CREATED, FLAG_MU_BEYOND_CRITICAL, FLAG_TENSILE_IMPULSE
 from ..crash3 import Crash3Result
+from ..residue import drop_residue, quantity_scales
 from ..result import UNIT_LABELS
 from ..scene import Scene
 from .canvas import _angle, _Canvas
 from .crash3 import save_crash3
+from .glyphs import one_glyph_warning
 from .inputs import SceneLike, _add, _norm, _num, _resolve, _scale, _sub
 from .labels import place_labels
 from .layout import _auto_scale, _bodies, _Body, _characteristic_length, _frame
@@ -121,7 +123,8 @@ def scene(
         import matplotlib.pyplot as plt
 
         _, ax = plt.subplots(figsize=(9.0, 6.5), layout="constrained")
-    _draw(ax, the_scene, the_result, position, velocity_scale, legend, title)
+    with one_glyph_warning():
+        _draw(ax, the_scene, the_result, position, velocity_scale, legend, title)
     return ax
 
 
@@ -155,19 +158,20 @@ def save_plot(
     fig = Figure(figsize=(9.0, 6.5), layout="constrained")
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
-    _draw(
-        ax,
-        the_scene,
-        the_result,
-        position,
-        options.pop("velocity_scale", None),
-        options.pop("legend", True),
-        options.pop("title", None),
-    )
-    if options:
-        raise TypeError(f"save_plot: unexpected options {', '.join(sorted(options))}")
-    path = Path(path)
-    fig.savefig(path, dpi=dpi, bbox_inches="tight")
+    with one_glyph_warning():
+        _draw(
+            ax,
+            the_scene,
+            the_result,
+            position,
+            options.pop("velocity_scale", None),
+            options.pop("legend", True),
+            options.pop("title", None),
+        )
+        if options:
+            raise TypeError(f"save_plot: unexpected options {', '.join(sorted(options))}")
+        path = Path(path)
+        fig.savefig(path, dpi=dpi, bbox_inches="tight")
     return path
 
 
@@ -211,6 +215,13 @@ def _draw(
 
     # velocity scale: drawn length per velocity unit
     k = velocity_scale if velocity_scale else _auto_scale(bodies, size)
+    speeds = [_norm(v) for body in bodies for v in (body.v0, body.v1) if v is not None]
+    rate_scale = quantity_scales(  # rounding residue of a zero is not drawn (impactsym.residue)
+        [("speed", v) for v in speeds]
+        + [("yaw_rate", w) for b in bodies for w in (b.w0, b.w1) if w is not None]
+    )["yaw_rate"]
+    for body in bodies:
+        body.w0, body.w1 = (None if w is None else drop_residue(w, rate_scale) for w in (body.w0, body.w1))
     rates = [abs(w) for body in bodies for w in (body.w0, body.w1) if w is not None]
     wmax = max(rates, default=0.0)
 
@@ -429,6 +440,19 @@ def _pdof_label(body: _Body) -> str:
     return f"PDOF {round(clockwise)}° ({clock} o'clock)"  # an int: no "-0°"
 
 
+def shown_beside(value: float, bounds: tuple[float, ...], digits: int = 3) -> str:
+    """``value`` with ``digits`` significant digits, or as many more as it
+    takes not to read as one of ``bounds`` it differs from (a flag raised for
+    e_m = 1.00067 must not be captioned "e_m = 1"); then as few as show it on
+    the same side of that bound."""
+    for places in range(digits, 18):
+        text = f"{value:.{places}g}"
+        shown = float(text)
+        if not any(b != value and (shown == b or (shown > b) != (value > b)) for b in bounds):
+            return text
+    return repr(value)
+
+
 def _title(scene: Scene, result: Any) -> str:
     impact = scene.impact
     name = scene.source.name if scene.source is not None else "scene"
@@ -446,16 +470,16 @@ def _title(scene: Scene, result: Any) -> str:
     )
     if getattr(result, "kind", None) == "reconstruct":
         head = (
-            f"{name}: reconstruction, {scene.units}; Γ = {impact.normal_angle:g}°, implied e = {result.e:.3g}, "
-            f"e_m = {result.e_m:.3g}"
+            f"{name}: reconstruction, {scene.units}; Γ = {impact.normal_angle:g}°, implied e = "
+            f"{shown_beside(result.e, (0.0, 1.0))}, e_m = {shown_beside(result.e_m, (-1.0, 1.0))}"
         )
     if result is None:
         return head
     energy = UNIT_LABELS[scene.units]["energy"]
     parts = []
     mu_value, mu_c = _num(getattr(result, "mu", None)), _num(getattr(result, "mu_c", None))
-    if mu_value is not None:
-        parts.append(f"μ = {mu_value:.3g}")
+    if mu_value is not None:  # digits enough to tell μ from its bounds 0 and μ_c (flag 4)
+        parts.append(f"μ = {shown_beside(mu_value, (0.0,) if mu_c is None else (0.0, mu_c))}")
     if mu_c is not None:
         parts.append(f"μ_c = {mu_c:.3g}")
     loss = _num(getattr(result, "TL", None))

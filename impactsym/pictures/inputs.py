@@ -32,6 +32,12 @@ def _resolve(obj: Any, scene: SceneLike | None, result: Any) -> tuple[Scene, Any
         if result is not None:
             raise TypeError("plot: give the result once (positionally or as result=)")
         result = obj
+        if hasattr(obj, "figure") and hasattr(obj, "get_xlim"):  # matplotlib Axes, not a result
+            raise TypeError(
+                "plot: got matplotlib Axes; save_plot draws a scene diagram from a result or a scene. "
+                "To save a picture already drawn (a sweep plot, say), use ax.figure.savefig(path), "
+                "or impactsym.plot.save_sweep(frame, path, x=...)"
+            )
         if scene is None:
             scene = getattr(result, "scene", None)
         if scene is None:

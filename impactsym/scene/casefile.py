@@ -388,14 +388,28 @@ def _vehicle_frame(values: Mapping, path: str):
     return distance * np.cos(angle), distance * np.sin(angle)
 
 
+#: Rounding units of the floor under which n·(r1 - r2) does not decide the
+#: normal's sense (a few operations of error each, with a margin of 4).
+_SENSE_ROUNDING = 16.0
+
+
 def used_normal_angle(given, r1, r2):
     """(Γ used [deg], flipped): the sense of the crush-surface normal that
     points from vehicle 1 toward vehicle 2, ``n·(r1 - r2) > 0`` (the centre of
     gravity of 2 seen from that of 1 is ``r1 - r2``). When the geometry cannot
-    tell (``n·(r1 - r2) = 0``: particles, no impact points) Γ is kept."""
+    tell, Γ is kept: ``n·(r1 - r2) = 0`` (particles, no impact points, or the
+    points along the crush surface's tangent) or within its rounding.
+
+    Rounding floor: cos Γ and sin Γ of a rounded ``deg2rad(Γ)`` are each off by
+    at most about ``eps·(1 + |Γ|)`` (Γ in radians), and the lever arms r1, r2
+    (rotated from the vehicle frame) by ``eps·|r|`` per component, so a dot
+    product within ``_SENSE_ROUNDING·eps·(1 + |Γ|)·(|r1| + |r2|)`` of zero is
+    rounding: cos(-90°) = 6.1e-17, not 0, must not turn a normal round."""
     gamma = np.deg2rad(given)
     dot = np.cos(gamma) * (r1[0] - r2[0]) + np.sin(gamma) * (r1[1] - r2[1])
-    flipped = dot < 0.0
+    arms = np.hypot(r1[0], r1[1]) + np.hypot(r2[0], r2[1])
+    floor = _SENSE_ROUNDING * np.finfo(np.float64).eps * (1.0 + np.abs(gamma)) * arms
+    flipped = dot < -floor
     return given + np.where(flipped, 180.0, 0.0), flipped
 
 

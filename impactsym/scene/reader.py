@@ -33,6 +33,7 @@ from .casefile import (
 )
 from .fields import as_choice, as_flag, as_mapping, as_name, require_key
 from .model import CRITICAL, KINDS, MODELS, UNITS, Impact, Scene, Vehicle, pair, uses_yaw
+from .plausibility import implausible
 
 
 def load_scene(source: Scene | Mapping | str | Path, kind: str = "forward") -> Scene:
@@ -195,6 +196,7 @@ def _parse_scene(data: Any, source: Path | None, kind: str) -> Scene:
     warnings = reading.warnings
     if kind in ("forward", "inverse"):
         warnings += _unused_coefficients(impact_data, model)
+    warnings += implausible(leaves, vehicles, units)
     return Scene(
         model, units, impact, vehicles, source, extra, tuple(warnings), kind, leaves, correlations, data
     )
@@ -216,19 +218,23 @@ def _fixed(entry: Mapping, index: int) -> bool:
     return as_flag(entry.get("fixed", False), f"vehicles[{index}].fixed")
 
 
+def _not_used_why(kind: str, key: str) -> str:
+    """Why a reconstruction or CRASH3 does not read the coefficient ``key``."""
+    if kind == "reconstruct":
+        return "a reconstruction infers it from the motion"
+    if key == "restitution":
+        return "CRASH3 takes its restitution from the crash3 options"
+    return "CRASH3 has no tangential or moment impulse law (it works from crush energy)"
+
+
 def _parse_coefficients(data: Mapping, reading: _Reading) -> dict[str, Any]:
     """The impact coefficients of a forward or inverse scene (the model's
     preset says which the scene gives and which it fixes). A reconstruction
     infers them and CRASH3 uses none: there they are reported as not used."""
     if reading.kind in ("reconstruct", "crash3"):
-        why = (
-            "a reconstruction infers them from the motion"
-            if reading.kind == "reconstruct"
-            else "CRASH3 takes its restitution from the crash3 options"
-        )
         for key in COEFFICIENT_KEYS:
             if key in data:
-                reading.not_used(f"impact.{key}", why)
+                reading.not_used(f"impact.{key}", _not_used_why(reading.kind, key))
         return {"restitution": math.nan, "impulse_ratio": math.nan, "moment_restitution": math.nan}
     preset = PRESETS[reading.model]
     coefficients = {key: _coefficient(data, key, preset, reading) for key in COEFFICIENT_KEYS}

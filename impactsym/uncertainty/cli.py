@@ -12,9 +12,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 
+from ..residue import without_json_residue
+from ..result import json_clean
 from ..scene import SceneError
 from .propagation import uncertainty
+from .result import MIN_INTERVAL_DRAWS
 
 DEFAULT_DRAWS = 10_000
 
@@ -30,9 +34,9 @@ def add_arguments(parser: argparse.ArgumentParser, plot: bool = False) -> None:
     group.add_argument(
         "--draws",
         type=int,
-        default=DEFAULT_DRAWS,
+        default=None,
         metavar="N",
-        help=f"Monte Carlo draws (default {DEFAULT_DRAWS})",
+        help=f"Monte Carlo draws (default {DEFAULT_DRAWS}, at least {MIN_INTERVAL_DRAWS})",
     )
     group.add_argument(
         "--seed",
@@ -48,22 +52,38 @@ def add_arguments(parser: argparse.ArgumentParser, plot: bool = False) -> None:
         group.add_argument("--plot", metavar="OUT.png", help="with --uncertainty: histograms and budget")
 
 
+def warn_unused(args: argparse.Namespace) -> None:
+    """Say on stderr which uncertainty options were given without ``--uncertainty``
+    (they are read only with it)."""
+    given = [
+        name
+        for name, value in (("--draws", args.draws), ("--seed", args.seed), ("--sobol", args.sobol or None))
+        if value is not None
+    ]
+    if given and not args.uncertainty:
+        print(
+            f"impactsym: warning: {', '.join(given)} ignored: read only with --uncertainty", file=sys.stderr
+        )
+
+
 def run(args: argparse.Namespace, command: str, result, **options) -> int:
     """Print `result` with the uncertainty of `command` for ``args.scene``."""
-    try:
-        u = uncertainty(
-            args.scene, command=command, draws=args.draws, seed=args.seed, sobol=args.sobol, **options
+    draws = DEFAULT_DRAWS if args.draws is None else args.draws
+    if draws < MIN_INTERVAL_DRAWS:
+        raise SceneError(
+            f"{draws} draws cannot give a 90 % interval; give at least {MIN_INTERVAL_DRAWS}", "--draws"
         )
+    try:
+        u = uncertainty(args.scene, command=command, draws=draws, seed=args.seed, sobol=args.sobol, **options)
     except (ValueError, ImportError) as exc:  # a one-line reason, exit code 2
         raise SceneError(str(exc)) from None
     if getattr(args, "plot", None):
         from .plot import save_uncertainty_plot
 
-        save_uncertainty_plot(u, args.plot)
+        save_uncertainty_plot(u, args.plot, names=[v.name for v in result.vehicles], units=result.units)
     if args.json:
-        print(
-            json.dumps({**result.to_json_dict(), "uncertainty": u.to_json_dict()}, indent=2, allow_nan=False)
-        )
+        both = without_json_residue({**result.to_json_dict(), "uncertainty": u.to_json_dict()})
+        print(json.dumps(json_clean(both), indent=2, allow_nan=False))
     else:
         print(result.table())
         print()

@@ -55,7 +55,7 @@ from .._kernels import CODES as _codes
 from ..batch.sweeps import BLOCK, CHUNK_SIZE, SamplePlan
 from .commands import COMMANDS, COMPLEX_STEP, RECONSTRUCT, Command, command_for
 from .inputs import Input, cholesky, correlation_matrix
-from .result import KEEP, Stats, Uncertainty
+from .result import KEEP, MIN_INTERVAL_DRAWS, Stats, Uncertainty
 
 STATUS_NAMES = {getattr(_codes, n): n[len("STATUS_") :] for n in dir(_codes) if n.startswith("STATUS_")}
 FLAG_NAMES = {n[len("FLAG_") :]: getattr(_codes, n) for n in dir(_codes) if n.startswith("FLAG_")}
@@ -307,6 +307,11 @@ def _notes(flags: int, accepted: int, draws: int, rejected: dict) -> list[str]:
             notes.append(f"{what} at the nominal values; {share:.0%} of draws are physical ({verdict})")
     if accepted == 0:
         notes.append("no draw is physical: the statistics are undefined")
+    elif accepted < MIN_INTERVAL_DRAWS:
+        notes.append(
+            f"only {accepted} accepted draws: the 90 % interval (p5, p95) needs at least "
+            f"{MIN_INTERVAL_DRAWS}; take more draws"
+        )
     return notes
 
 

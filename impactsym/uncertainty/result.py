@@ -9,14 +9,19 @@ from typing import Any
 import numpy as np
 
 from ..batch.quantiles import percentiles
+from ..residue import without_json_residue
 
-__all__ = ["Uncertainty", "Stats", "KEEP", "HISTOGRAM_BINS", "PERCENTILES"]
+__all__ = ["Uncertainty", "Stats", "KEEP", "HISTOGRAM_BINS", "MIN_INTERVAL_DRAWS", "PERCENTILES"]
 
 #: Accepted draws kept for the caller (`Uncertainty.draws`); statistics use every draw.
 KEEP = 1 << 20
 #: Bins of the streaming histograms that give percentiles beyond KEEP accepted draws.
 HISTOGRAM_BINS = 1 << 16
 PERCENTILES = (5.0, 50.0, 95.0)
+#: Fewest accepted draws for a 90 % interval: with N draws the 5th and 95th
+#: percentiles sit N/20 order statistics in from the extremes; at 100 that is
+#: 5 draws each side, below it p5 and p95 are little more than min and max.
+MIN_INTERVAL_DRAWS = 100
 
 
 class Stats:
@@ -186,7 +191,11 @@ class Uncertainty:
             "",
             (f"{'output':<{width}}{'nominal':>12}{'mean':>12}{'90 % interval':>26}  largest budget shares"),
         ]
+        shown = ("nominal", "mean", "p5", "p95")  # rounding residue shown as 0 (impactsym.residue)
+        outputs = {p: {k: o[k] for k in shown if o[k] is not None} for p, o in self.outputs.items()}
+        outputs = without_json_residue({"uncertainty": {"outputs": outputs}})["uncertainty"]["outputs"]
         for path, o in self.outputs.items():
+            o = {**o, **outputs[path]}
             top = sorted(self.budget.get(path, {}).items(), key=lambda kv: -abs(kv[1]))[:3]
             interval = f"[{_cell(o['p5'])}, {_cell(o['p95'])}]"
             lines.append(

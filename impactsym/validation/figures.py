@@ -89,42 +89,49 @@ def plot(datasets: list[Dataset], directory: Path | str) -> list[Path]:
     directory.mkdir(parents=True, exist_ok=True)
     paths = []
     for ds in datasets:
-        panels = PLOTS[ds.name]
-        fig, axes = plt.subplots(1, len(panels), figsize=(5.2 * len(panels), 4.6), squeeze=False)
-        for ax, (title, reference, series) in zip(axes[0], panels):
-            top = 0.0
-            comps = [_find(ds, e[0], e[1], e[2] if len(e) > 2 else reference) for e in series]
-            mixed_q = len({c.quantity for c in comps}) > 1
-            mixed_r = len({c.reference for c in comps}) > 1
-            # One model against several references: the model in the title, the
-            # references in the legend.
-            by_reference = mixed_r and not mixed_q and len({c.model for c in comps}) == 1
-            if by_reference:
-                title = f"{title}\n{comps[0].model}"
-            for comp in comps:
-                xs, ys = [r for _, _, r in comp.rows], [m for _, m, _ in comp.rows]
-                label = (
-                    comp.reference
-                    if by_reference
-                    else comp.model
-                    + (f", {comp.quantity}" if mixed_q else "")
-                    + (f" vs {comp.reference}" if mixed_r else "")
-                )
-                ax.scatter(
-                    xs, ys, s=22, alpha=0.8, label=f"{label} (median |err| {comp.stats()['median']:.1f} %)"
-                )
-                top = max(top, *xs, *ys)
-            ax.ticklabel_format(style="sci", scilimits=(-3, 4))
-            ax.plot([0, top * 1.05], [0, top * 1.05], "k--", lw=1, label="1:1")
-            ax.set_xlabel("reference")
-            ax.set_ylabel("model")
-            ax.set_title(title, fontsize=10)
-            ax.legend(fontsize=7)
-            ax.set_aspect("equal", adjustable="box")
-        fig.suptitle(ds.title, fontsize=11)
-        fig.tight_layout()
+        fig = figure(ds, plt)
         path = directory / f"{ds.name}.png"
-        fig.savefig(path, dpi=110)
+        fig.savefig(path, dpi=110, bbox_inches="tight")
         plt.close(fig)
         paths.append(path)
     return paths
+
+
+def figure(ds: Dataset, plt):
+    """The predicted-versus-measured figure of one dataset (pyplot `plt`); each
+    panel's legend below its axes, where it covers no point."""
+    panels = PLOTS[ds.name]
+    fig, axes = plt.subplots(1, len(panels), figsize=(5.2 * len(panels), 4.6), squeeze=False)
+    for ax, (title, reference, series) in zip(axes[0], panels):
+        top = 0.0
+        comps = [_find(ds, e[0], e[1], e[2] if len(e) > 2 else reference) for e in series]
+        mixed_q = len({c.quantity for c in comps}) > 1
+        mixed_r = len({c.reference for c in comps}) > 1
+        # One model against several references: the model in the title, the
+        # references in the legend.
+        by_reference = mixed_r and not mixed_q and len({c.model for c in comps}) == 1
+        if by_reference:
+            title = f"{title}\n{comps[0].model}"
+        for comp in comps:
+            xs, ys = [r for _, _, r in comp.rows], [m for _, m, _ in comp.rows]
+            label = (
+                comp.reference
+                if by_reference
+                else comp.model
+                + (f", {comp.quantity}" if mixed_q else "")
+                + (f" vs {comp.reference}" if mixed_r else "")
+            )
+            ax.scatter(
+                xs, ys, s=22, alpha=0.8, label=f"{label} (median |err| {comp.stats()['median']:.1f} %)"
+            )
+            top = max(top, *xs, *ys)
+        ax.ticklabel_format(style="sci", scilimits=(-3, 4))
+        ax.plot([0, top * 1.05], [0, top * 1.05], "k--", lw=1, label="1:1")
+        ax.set_xlabel("reference")
+        ax.set_ylabel("model")
+        ax.set_title(title, fontsize=10)
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14))
+        ax.set_aspect("equal", adjustable="box")
+    fig.suptitle(ds.title, fontsize=11)
+    fig.tight_layout()
+    return fig

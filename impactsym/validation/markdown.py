@@ -251,10 +251,15 @@ def markdown(datasets: list[Dataset], figures: Mapping[str, str] | None = None) 
 def text_summary(datasets: list[Dataset]) -> str:
     """The error statistics as a plain-text table for a terminal."""
     rows = statistics_rows(datasets)
-    head = f"{'dataset':8} {'model':52} {'quantity':22} {'reference':30} {'n':>3} {'median%':>8} {'worst%':>8} {'bias%':>8}"
+    # each text column as wide as its longest entry: names are never cut
+    w = {k: max([len(k)] + [len(r[k]) for r in rows]) for k in ("dataset", "model", "quantity", "reference")}
+    head = (
+        f"{'dataset':{w['dataset']}} {'model':{w['model']}} {'quantity':{w['quantity']}} "
+        f"{'reference':{w['reference']}} {'n':>3} {'median%':>8} {'worst%':>8} {'bias%':>8}"
+    )
     body = [
-        f"{r['dataset']:8} {r['model'][:52]:52} {r['quantity'][:22]:22} {r['reference'][:30]:30} "
-        f"{r['n']:3d} {r['median']:8.1f} {r['worst']:8.1f} {r['bias']:8.1f}"
+        f"{r['dataset']:{w['dataset']}} {r['model']:{w['model']}} {r['quantity']:{w['quantity']}} "
+        f"{r['reference']:{w['reference']}} {r['n']:3d} {r['median']:8.1f} {r['worst']:8.1f} {r['bias']:8.1f}"
         for r in rows
     ]
     return "\n".join([head, *body])
