@@ -11,6 +11,27 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
+#: The command a bundled example is written for, by its name's prefix (examples/README.md);
+#: every other top-level example is a forward scene for ``solve``.
+EXAMPLE_COMMANDS = {"invert_": "invert", "reconstruct_": "reconstruct", "crash3_": "crash3", "fit_": "fit"}
+
+
+def example_files() -> list[Path]:
+    """Every top-level example scene (JSON or TOML), sorted."""
+    return sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml"))
+
+
+def example_command(path: Path) -> str:
+    """The command an example is for: ``solve`` unless its prefix names another."""
+    return next((cmd for prefix, cmd in EXAMPLE_COMMANDS.items() if path.name.startswith(prefix)), "solve")
+
+
+def forward_examples() -> list[Path]:
+    """The examples that are forward scenes (``solve``)."""
+    return [p for p in example_files() if example_command(p) == "solve"]
+
+
+EXAMPLES = ROOT / "examples"
 
 
 def run_cli(capsys, *argv) -> tuple[int, str, str]:

@@ -11,17 +11,12 @@ import pytest
 
 from impactsym.codes import FLAG_MESSAGES
 from impactsym.scene import load_scene
+from tests.helpers import forward_examples
 from tests.helpers import run_cli as run
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
-# Forward scenes; the other kinds are named by their command (invert_*, reconstruct_*, ...).
-OTHER_KINDS = ("invert_", "reconstruct_", "crash3_", "fit_")
-EXAMPLE_FILES = [
-    path
-    for path in sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml"))
-    if not path.name.startswith(OTHER_KINDS)
-]
+EXAMPLE_FILES = forward_examples()
 ENERGY_CREATED = 1
 
 CONVENTIONS_SCENE = json.loads((EXAMPLES / "two_car_us.json").read_text())

@@ -26,7 +26,7 @@ from impactsym.result import json_number, without_residue
 from impactsym.scene import load_scene
 from tests.helpers import cli_argv as _cli
 from tests.helpers import cli_env as _env
-from tests.helpers import one_line_error
+from tests.helpers import example_command, one_line_error
 from tests.helpers import run_cli as run
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -252,25 +252,12 @@ def test_json_never_prints_negative_zero():
     assert json_number(math.nan) is None
 
 
-def _command(path: Path) -> str:
-    """The command an example is written for (by its name's prefix)."""
-    for prefix, command in (
-        ("invert_", "invert"),
-        ("reconstruct_", "reconstruct"),
-        ("crash3_", "crash3"),
-        ("fit_", "fit"),
-    ):
-        if path.name.startswith(prefix):
-            return command
-    return "solve"
-
-
 @pytest.mark.parametrize(
     "path", sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml")), ids=lambda p: p.name
 )
 def test_no_example_prints_negative_zero_in_json(path, capsys):
     # crash3_barrier_si.json printed a -0.0 delta-V component before.
-    code, out, err = run(capsys, _command(path), path, "--json")
+    code, out, err = run(capsys, example_command(path), path, "--json")
     assert code == 0, err
     assert not re.search(r"-0\.0\b(?!\d)", out)
     json.loads(out)

@@ -10,15 +10,11 @@ import pytest
 import impactsym
 from impactsym import plot
 from impactsym.cli import main
-from tests.helpers import new_axes
+from tests.helpers import forward_examples, new_axes
 
 matplotlib.use("Agg")
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
-FORWARD = [
-    p
-    for p in sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml"))
-    if not p.name.startswith(("invert_", "reconstruct_", "crash3_", "fit_"))
-]
+FORWARD = forward_examples()
 MIN_PNG_BYTES = 20_000  # a blank 9x6.5 in figure at 120 dpi is about 8 kB
 
 

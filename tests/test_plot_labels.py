@@ -21,14 +21,11 @@ from matplotlib.text import Text
 import impactsym
 from impactsym import plot
 from impactsym.testing.figures import overlapping
+from tests.helpers import forward_examples
 
 matplotlib.use("Agg")
 EXAMPLES = FilePath(__file__).resolve().parent.parent / "examples"
-FORWARD = [
-    p
-    for p in sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml"))
-    if not p.name.startswith(("invert_", "reconstruct_", "crash3_", "fit_"))
-]
+FORWARD = forward_examples()
 CASES = (
     [(impactsym.solve, p) for p in FORWARD]
     + [(impactsym.invert, p) for p in sorted(EXAMPLES.glob("invert_*"))]

@@ -9,6 +9,7 @@ import pytest
 import impactsym
 from impactsym import load_scene
 from impactsym.scene.plausibility import RANGES, implausible
+from tests.helpers import example_command, example_files
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -17,18 +18,15 @@ def _example(name):
     return json.loads((EXAMPLES / name).read_text())
 
 
-def _kind(path):
-    for prefix, kind in (("invert_", "inverse"), ("reconstruct_", "reconstruct"), ("crash3_", "crash3")):
-        if path.name.startswith(prefix):
-            return kind
-    return "forward"
+#: The scene reader's kind for each example command (fit scenes are read by impactsym.evidence).
+KIND = {"solve": "forward", "invert": "inverse", "reconstruct": "reconstruct", "crash3": "crash3"}
 
 
 @pytest.mark.parametrize(
-    "path", sorted(EXAMPLES.glob("*.json")) + sorted(EXAMPLES.glob("*.toml")), ids=lambda p: p.name
+    "path", [p for p in example_files() if example_command(p) in KIND], ids=lambda p: p.name
 )
 def test_no_bundled_example_is_questioned(path):
-    scene = load_scene(path, kind=_kind(path))
+    scene = load_scene(path, kind=KIND[example_command(path)])
     assert implausible(scene.leaves, scene.vehicles, scene.units) == []
 
 

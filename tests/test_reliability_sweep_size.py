@@ -71,7 +71,7 @@ def test_a_killed_runs_spill_folder_is_removed_at_the_next_start():
 
 
 def test_sigkill_during_a_sweep_then_the_next_run_cleans_up(tmp_path):
-    env = {**os.environ, "TMPDIR": str(tmp_path), "IMPACTSYM_BACKGROUND_COMPILE": "0"}
+    env = {**os.environ, "TMPDIR": str(tmp_path)}
     code = (
         "import os, signal, impactsym.batch.spill as s\n"
         "with s.spill_folder() as f:\n"

@@ -10,7 +10,8 @@ import argparse
 import json
 
 from ..errors import SceneError
-from ..result import json_clean
+from ..residue import without_json_residue
+from ..result import json_clean, table_cell
 from .api import runout
 
 HELP = "post-impact run-out: each vehicle from separation to rest, or its separation velocity fitted to rest"
@@ -84,7 +85,9 @@ def run_chained(args: argparse.Namespace, command: str) -> int:
         raise SceneError("draw a chained scene's run-outs with impactsym runout SCENE --plot", "--plot")
     from .chain import reconstruct_from_rest, solve_to_rest
 
-    result = (solve_to_rest if command == "solve" else reconstruct_from_rest)(args.scene)
+    result = without_json_residue(
+        (solve_to_rest if command == "solve" else reconstruct_from_rest)(args.scene)
+    )
     print(json.dumps(json_clean(result), indent=2) if args.json else _chain_table(result))
     return 0
 
@@ -95,7 +98,8 @@ def _run_chain(args: argparse.Namespace) -> int:
 
     if args.plot:
         raise SceneError("--plot draws a plain run-out; leave out --chain to draw it", "--plot")
-    result = (solve_to_rest if args.chain == "solve" else reconstruct_from_rest)(args.scene, path=args.path)
+    chain = solve_to_rest if args.chain == "solve" else reconstruct_from_rest
+    result = without_json_residue(chain(args.scene, path=args.path))
     print(json.dumps(json_clean(result)) if args.json else _chain_table(result))
     return 0
 
@@ -104,7 +108,9 @@ def _chain_table(result: dict) -> str:
     lines = []
     for v in result["vehicles"]:
         ro = v.get("runout")
-        head = f"{v.get('name', '')}: velocity {v.get('velocity')}"
+        velocity = v.get("velocity")
+        shown = "[" + ", ".join(table_cell(x) for x in velocity) + "]" if velocity else velocity
+        head = f"{v.get('name', '')}: velocity {shown}"
         if ro is None:
             lines.append(head)
             continue
