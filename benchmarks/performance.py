@@ -838,12 +838,6 @@ def crossover(table: dict, serial: str, parallel: str) -> int | None:
 # ------------------------------------------------------------------ 5. sweep
 
 
-def sweep_available() -> bool:
-    """Whether impactsym/sweep.py defines ``sweep`` (another engineer is building it)."""
-    path = ROOT / "impactsym" / "sweep.py"
-    return path.exists() and "\ndef sweep(" in path.read_text()
-
-
 def run_sweep(points: int) -> dict:
     """``impactsym sweep SCENE_FILE --vary e=0:0.4:K --vary mu=0:0.6:K -o TMP.parquet
     --no-progress`` with K = round(sqrt(points)), in a child process: wall time, rows/s,
@@ -1370,8 +1364,8 @@ def add_arguments(parser) -> None:
     parser.add_argument(
         "--sweep",
         action=argparse.BooleanOptionalAction,
-        default=None,
-        help="run the impactsym sweep section (default: on when impactsym.sweep exists)",
+        default=True,
+        help="run the impactsym sweep section (default: on)",
     )
     parser.add_argument(
         "--sweep-points",
@@ -1403,18 +1397,9 @@ def add_arguments(parser) -> None:
 
 
 def _sweep_section(args, log) -> tuple[dict | None, str]:
-    """Run the sweep section if asked and possible; (its numbers or None, a note)."""
-    available = sweep_available()
-    wanted = available if args.sweep is None else args.sweep
-    if not wanted:
-        return None, (
-            "Not run (`--no-sweep`)."
-            if available
-            else "Not run: `impactsym.sweep` does not exist yet (impactsym/sweep.py has no "
-            "`def sweep`); the code to measure `impactsym sweep` is in place."
-        )
-    if not available:
-        return None, "Not run: `impactsym.sweep` does not exist yet (`--sweep` was given)."
+    """Run the sweep section unless `--no-sweep`; (its numbers or None, a note)."""
+    if not args.sweep:
+        return None, "Not run (`--no-sweep`)."
     log(f"5. sweep of {args.sweep_points:,} rows ...")
     with Load() as load:
         sweep = run_sweep(args.sweep_points)
