@@ -39,7 +39,35 @@ FIT_DIRECTION_DEG = 20.0
 FORWARD_CASES = ["VC-3.1", "VC-3.2", "VC-8.1", "VC-8.2", "VC-11.1"]
 FIT_MEASURED = ["VC-3.1", "VC-3.2", "VC-8.1", "VC-8.2", "VC-11.1"]
 FIT_ALL = ["VC-3.1", "VC-3.2", "VC-7.1", "VC-7.2", "VC-8.1", "VC-8.2", "VC-11.1"]
-XFAIL: dict[tuple[str, str], str] = {}
+# Findings of the first run (bounds above unchanged). With every wheel rolling at the
+# contract's f_r = 0.01 a car at the measured separation speed rolls 4-9 times the
+# measured distance: the straight roll to the measured rest needs a drag of 0.05-0.10 g
+# (column drag_needed); the cars rolled in gear with crushed fronts, which the
+# assumed wheel states leave out. The fit then reaches the rest pose only by sliding
+# sideways (directions 40-90 deg off the measured ones) or does not converge.
+ROLL = "all wheels rolling at f_r = 0.01 overshoots the measured run-out 4-9x (a straight roll needs 0.05-0.10 g, the spinning cars 0.3 g)"
+XFAIL: dict[tuple[str, str], str] = {
+    **{("forward position", c): ROLL for c in FORWARD_CASES},
+    (
+        "forward heading",
+        "VC-11.1",
+    ): "Honda: |W| 5.24 rad/s with rolling wheels spins ~255 deg, measured 77 deg",
+    (
+        "fit residual",
+        "VC-3.2",
+    ): "Pinto: the fit does not converge (rest 160 ft away needs a slide or more drag)",
+    ("fit residual", "VC-8.2"): "Rabbit: the fit does not converge (residual ~3 ft, ~46 deg)",
+    ("fit residual", "VC-11.1"): "Honda: the fit does not converge",
+    ("fit speed", "VC-3.1"): "Torino: fitted 3.2 m/s against 5.3 measured (the fit slides to stop in 103 ft)",
+    ("fit speed", "VC-3.2"): "Pinto: the fit does not converge",
+    ("fit speed", "VC-8.2"): "Rabbit: the fit does not converge",
+    ("fit speed", "VC-11.1"): "Honda: the fit does not converge",
+    ("fit direction", "VC-3.1"): "Torino: fitted velocity 40 deg off the measured (sideways slide)",
+    ("fit direction", "VC-3.2"): "Pinto: the fit does not converge",
+    ("fit direction", "VC-8.1"): "Chevelle: fitted velocity 71 deg off the measured (sideways slide)",
+    ("fit direction", "VC-8.2"): "Rabbit: the fit does not converge",
+    ("fit direction", "VC-11.1"): "Honda: the fit does not converge",
+}
 
 
 def _row(rows, label):
@@ -86,12 +114,14 @@ def test_fit_reaches_measured_rest(fitted, label):
 @pytest.mark.parametrize("label", [_case("fit speed", c) for c in FIT_MEASURED])
 def test_fit_speed_against_measured(fitted, label):
     r = _row(fitted, label)
+    assert r["converged"], r  # added after the first run: only a converged fit is a fitted speed
     assert abs(r["speed_pct"]) <= FIT_SPEED_PCT, r
 
 
 @pytest.mark.parametrize("label", [_case("fit direction", c) for c in FIT_MEASURED])
 def test_fit_direction_against_measured(fitted, label):
     r = _row(fitted, label)
+    assert r["converged"], r  # added after the first run (a tightening): as for the speed
     assert abs(r["direction_error_deg"]) <= FIT_DIRECTION_DEG, r
 
 

@@ -31,6 +31,22 @@ PLOTS = {
             ],
         ),
     ],
+    "ricsac_runout": [
+        (
+            "rest distance from separation [ft] vs measured",
+            "measured",
+            [
+                ("run-out, wheels rolling (forward)", "rest distance from separation"),
+                ("SIMON (Day 2004)", "rest distance from separation"),
+                ("EDSMAC4 (Day 2004)", "rest distance from separation"),
+            ],
+        ),
+        (
+            "separation speed [m/s] fitted to rest vs measured",
+            "measured (Vossou 2018)",
+            [("run-out fit to rest", "separation speed")],
+        ),
+    ],
     "iihs": [
         ("delta-V [ft/s] vs measured", "measured", [("rigid PIM (Brach's fits)", "delta-V")]),
         (
