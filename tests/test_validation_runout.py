@@ -16,8 +16,8 @@ CG position ASSUMED from nominal manufacturer data. With that many assumptions:
 - (a) forward run-out from the measured separation velocity: rest position within
   25 % of the measured run-out distance (separation to rest, straight line) and
   rest heading within 30° (wrapped), per vehicle with a free run-out (VC-11's
-  Torino struck a transformer box: shown, not judged). EDSMAC4 and SIMON, tuned
-  by their authors, miss by up to ~20 ft and ~25° on these tests (Table 7).
+  Torino struck a transformer box: shown, not judged). EDSMAC4 and SIMON, with
+  inputs their authors chose, miss the free run-outs by up to ~6 ft and ~21° (Table 7).
 - (b) fit to the measured rest pose: the fit converges to within 0.1 ft and 0.5°;
   the fitted separation speed within 25 % of the measured speed and the direction
   of the fitted separation velocity within 20° of the measured direction.
@@ -45,7 +45,7 @@ FIT_ALL = ["VC-3.1", "VC-3.2", "VC-7.1", "VC-7.2", "VC-8.1", "VC-8.2", "VC-11.1"
 # (column drag_needed); the cars rolled in gear with crushed fronts, which the
 # assumed wheel states leave out. The fit then reaches the rest pose only by sliding
 # sideways (directions 40-90 deg off the measured ones) or does not converge.
-ROLL = "all wheels rolling at f_r = 0.01 overshoots the measured run-out 4-9x (a straight roll needs 0.05-0.10 g, the spinning cars 0.3 g)"
+ROLL = "all wheels rolling at f_r = 0.01 rolls 4.6-9.5x the measured run-out distance (a straight roll needs 0.05-0.10 g, the spinning cars 0.3 g)"
 XFAIL: dict[tuple[str, str], str] = {
     **{("forward position", c): ROLL for c in FORWARD_CASES},
     (

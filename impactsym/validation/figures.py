@@ -37,6 +37,7 @@ PLOTS = {
             "measured",
             [
                 ("run-out, wheels rolling (forward)", "rest distance from separation"),
+                ("run-out, wheels locked (bracket)", "rest distance from separation"),
                 ("SIMON (Day 2004)", "rest distance from separation"),
                 ("EDSMAC4 (Day 2004)", "rest distance from separation"),
             ],

@@ -215,6 +215,7 @@ COMPARISONS: dict[str, list[Spec]] = {
             )
             for model, rows, got in (
                 (RUNOUT_FORWARD, "forward", "distance_ft"),
+                ("run-out, wheels locked (bracket)", "forward", "locked distance_ft"),
                 ("SIMON (Day 2004)", "table", "SIMON distance_ft"),
                 ("EDSMAC4 (Day 2004)", "table", "EDSMAC4 distance_ft"),
             )
@@ -408,8 +409,15 @@ def _ricsac_runout() -> Dataset:
     _run(ds, {})
     rolls = [r["drag_needed"] for r in ds.tables["forward"] if r["free"] and abs(r["yaw_rate"]) < 1.0]
     spins = [r["drag_needed"] for r in ds.tables["forward"] if r["free"] and abs(r["yaw_rate"]) >= 1.0]
+    free = [r for r in ds.tables["forward"] if r["free"]]
+    inside = [
+        r["label"] for r in free if r["locked distance_ft"] <= r["runout_distance_ft"] <= r["distance_ft"]
+    ]
     ds.notes += [
         ASSUMPTIONS["ricsac_runout"],
+        f"Bracket (every wheel locked instead of rolling, same separation state): the measured "
+        f"run-out distance lies between the locked and the rolling prediction for {len(inside)} of "
+        f"{len(free)} free run-outs ({', '.join(inside) or 'none'}).",
         "Measured rest and separation in Day's frame (ft, deg; SAE: Y right, heading clockwise). "
         "Position error is the distance between predicted and measured rest; the run-out distance "
         "is the straight line from separation to the measured rest.",

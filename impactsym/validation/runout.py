@@ -81,7 +81,7 @@ def _measured_velocity(sep: dict[str, str]) -> tuple[float, float, float] | None
     return -vx, -vy, -int(sep["yaw_sign"]) * w  # 180 deg turn; Day's clockwise -> scene's negative
 
 
-def _scene(sep: dict[str, str], velocity=None, rest=None) -> dict[str, Any]:
+def _scene(sep: dict[str, str], velocity=None, rest=None, wheels: str = "rolling") -> dict[str, Any]:
     """A one-vehicle SI run-out scene in the scene frame (x = X, y = -Y, psi = -Psi)."""
     car = _vehicles()[sep["vehicle_row"]]
     wheelbase = float(sep["wheelbase_in"]) * INCH
@@ -96,7 +96,7 @@ def _scene(sep: dict[str, str], velocity=None, rest=None) -> dict[str, Any]:
         "wheelbase": wheelbase,
         "cg_to_front_axle": CG_SHARE.get(sep["name"], 0.45) * wheelbase,
         "track": TRACK_IN[float(sep["wheelbase_in"])] * INCH,
-        "wheels": "rolling",
+        "wheels": wheels,
         "separation": separation,
     }
     if rest is not None:
@@ -159,9 +159,14 @@ def _forward() -> tuple[dict[str, Any], ...]:
         pose = _day(entry)
         measured = (row["measured X"], row["measured Y"], row["measured psi"])
         separation = (row["separation X"], row["separation Y"], row["separation psi"])
+        # the other end of the wheel states: every wheel locked (a bracket, not a fit)
+        locked = _errors(
+            _day(runout(_scene(sep, velocity, wheels="locked"))["vehicles"][0]), measured, separation
+        )
         out.append(
             {
                 **row,
+                **{f"locked {k}": v for k, v in locked.items()},
                 "X": pose[0],
                 "Y": pose[1],
                 "psi": pose[2],
@@ -177,7 +182,8 @@ def _forward() -> tuple[dict[str, Any], ...]:
 
 
 def ricsac_runout_forward() -> list[dict[str, Any]]:
-    """Forward run-outs from Vossou's measured separation velocities (RICSAC 3, 6, 10)."""
+    """Forward run-outs from Vossou's measured separation velocities (RICSAC 3, 6, 10),
+    every wheel rolling (the assumption) and, as a bracket, every wheel locked."""
     return [dict(r) for r in _forward()]
 
 
