@@ -221,6 +221,7 @@ def test_cli_validate(capsys, tmp_path):
     assert {p.name for p in tmp_path.glob("*.png")} == {
         "ricsac.png",
         "ricsac_runout.png",
+        "ricsac_runout_plan.png",
         "iihs.png",
         "iihs_v2v.png",
         "nhtsa.png",

@@ -110,6 +110,13 @@ def _day(entry: dict[str, Any]) -> tuple[float, float, float]:
     return x / FT, -y / FT, -entry["rest"]["heading"]
 
 
+def _path(entry: dict[str, Any], points: int = 400) -> tuple[tuple[float, float], ...]:
+    """The CG path of a run-out entry in Day's frame (ft), thinned to about `points`."""
+    path = entry["path"]
+    step = max(1, len(path) // points)
+    return tuple((p[1] / FT, -p[2] / FT) for p in [*path[::step], path[-1]])
+
+
 def _errors(pose, measured, separation) -> dict[str, float]:
     return {
         "position_error_ft": math.hypot(pose[0] - measured[0], pose[1] - measured[1]),
@@ -155,18 +162,19 @@ def _forward() -> tuple[dict[str, Any], ...]:
         velocity = _measured_velocity(sep)
         if velocity is None:
             continue
-        entry = runout(_scene(sep, velocity))["vehicles"][0]
+        entry = runout(_scene(sep, velocity), path=True)["vehicles"][0]
         pose = _day(entry)
         measured = (row["measured X"], row["measured Y"], row["measured psi"])
         separation = (row["separation X"], row["separation Y"], row["separation psi"])
         # the other end of the wheel states: every wheel locked (a bracket, not a fit)
-        locked = _errors(
-            _day(runout(_scene(sep, velocity, wheels="locked"))["vehicles"][0]), measured, separation
-        )
+        locked_entry = runout(_scene(sep, velocity, wheels="locked"), path=True)["vehicles"][0]
+        locked = _errors(_day(locked_entry), measured, separation)
         out.append(
             {
                 **row,
                 **{f"locked {k}": v for k, v in locked.items()},
+                "path": _path(entry),
+                "locked path": _path(locked_entry),
                 "X": pose[0],
                 "Y": pose[1],
                 "psi": pose[2],
