@@ -324,8 +324,8 @@ def _ricsac() -> Dataset:
         ASSUMPTIONS["ricsac_pim"],
         f"Vossou's measured separation velocities do not conserve momentum (worst: test "
         f"{worst['test']}, {worst['x_pct']:+.1f} % of the initial momentum in x; test 1 "
-        "to 10 between 1 and 17 %): the post-impact data are contaminated, so no model is "
-        "fitted or judged on them. Test 12's pre-impact v1y (-4.28 m/s) also looks "
+        "to 10 between 1 and 17 %): the post-impact data are contaminated, so no impact model "
+        "is fitted or judged on them (the run-out check uses them, saying so). Test 12's pre-impact v1y (-4.28 m/s) also looks "
         "suspect (the y balance is off by 76 %); the rigid PIM uses it as published.",
         IMPLAUSIBLE["7.2"],
     ]
