@@ -218,7 +218,14 @@ def test_cli_validate(capsys, tmp_path):
     assert main(["validate", "--markdown", "--plots", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "| model | quantity | reference |" in out and "PHYSICALLY IMPOSSIBLE" in out
-    assert {p.name for p in tmp_path.glob("*.png")} == {"ricsac.png", "iihs.png", "iihs_v2v.png", "nhtsa.png"}
+    assert {p.name for p in tmp_path.glob("*.png")} == {
+        "ricsac.png",
+        "ricsac_runout.png",
+        "ricsac_runout_plan.png",
+        "iihs.png",
+        "iihs_v2v.png",
+        "nhtsa.png",
+    }
 
 
 def test_v2v_conserves_momentum_and_is_physical(datasets):

@@ -20,6 +20,12 @@ with programmatic scenes:
   distance APPROXIMATED from his barrier fits of the same car model and the
   masses ASSUMED (the Fusion's), against the measured |delta-V| and yaw-rate
   change, with the sensitivity to d, the mass ratio and k;
+- **RICSAC rest positions** (RICSAC 2, 3, 6, 10; Day, SAE 2004-01-1207, Table 7):
+  the run-out forward from Vossou's measured separation velocities with every
+  wheel ASSUMED rolling (and locked, as a bracket), and the separation state
+  fitted to the measured rest pose against the measured one; SIMON's and
+  EDSMAC4's published rest positions beside; separation poses read from the
+  paper's figures;
 - **NHTSA 4364, 4438, 4474** (car-to-SUV, Rose et al. SAE 2006-01-0908): the
   rigid model with the published inputs against the published PIM energies,
   delta-V and yaw rates, and the measured delta-V.
@@ -30,7 +36,7 @@ and the median signed error (bias). Every assumption is stated in ``ASSUMPTIONS`
 and in the tables' notes; nothing is tuned to the measurements.
 
 The rooms: ``common`` (data folder, reader, Comparison, statistics), one loader
-module per source (``ricsac``, ``iihs``, ``nhtsa``), ``report`` (the table of
+module per source (``ricsac``, ``runout``, ``iihs``, ``nhtsa``), ``report`` (the table of
 comparisons run on them), ``figures`` and ``markdown`` (output).
 """
 
@@ -41,6 +47,7 @@ from .markdown import markdown, statistics_rows, text_summary
 from .nhtsa import nhtsa
 from .report import ASSUMPTIONS, COMPARISONS, report
 from .ricsac import ricsac_crash3, ricsac_energy, ricsac_momentum, ricsac_pim
+from .runout import ricsac_runout_fit, ricsac_runout_forward, ricsac_runout_table
 
 __all__ = [
     "ASSUMPTIONS",
@@ -58,6 +65,9 @@ __all__ = [
     "ricsac_energy",
     "ricsac_momentum",
     "ricsac_pim",
+    "ricsac_runout_fit",
+    "ricsac_runout_forward",
+    "ricsac_runout_table",
     "statistics_rows",
     "stats",
     "text_summary",

@@ -65,9 +65,10 @@ def stats(errors: list[float]) -> dict[str, Any]:
 
 @cache
 def read(name: str, data_dir: Path = DATA_DIR) -> tuple[dict[str, str], ...]:
-    """A CSV of the validation folder as row dicts (text kept as published)."""
+    """A CSV of the validation folder as row dicts (text kept as published);
+    lines starting with ``#`` are the file's comments (source, units, defects)."""
     with open(data_dir / f"{name}.csv", newline="", encoding="utf-8") as handle:
-        return tuple(csv.DictReader(handle))
+        return tuple(csv.DictReader(line for line in handle if not line.startswith("#")))
 
 
 def num(text: str) -> float | None:

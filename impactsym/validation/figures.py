@@ -31,6 +31,23 @@ PLOTS = {
             ],
         ),
     ],
+    "ricsac_runout": [
+        (
+            "rest distance from separation [ft] vs measured",
+            "measured",
+            [
+                ("run-out, wheels rolling (forward)", "rest distance from separation"),
+                ("run-out, wheels locked (bracket)", "rest distance from separation"),
+                ("SIMON (Day 2004)", "rest distance from separation"),
+                ("EDSMAC4 (Day 2004)", "rest distance from separation"),
+            ],
+        ),
+        (
+            "separation speed [m/s] fitted to rest vs measured",
+            "measured (Vossou 2018)",
+            [("run-out fit to rest", "separation speed")],
+        ),
+    ],
     "iihs": [
         ("delta-V [ft/s] vs measured", "measured", [("rigid PIM (Brach's fits)", "delta-V")]),
         (
@@ -89,11 +106,14 @@ def plot(datasets: list[Dataset], directory: Path | str) -> list[Path]:
     directory.mkdir(parents=True, exist_ok=True)
     paths = []
     for ds in datasets:
-        fig = figure(ds, plt)
-        path = directory / f"{ds.name}.png"
-        fig.savefig(path, dpi=110, bbox_inches="tight")
-        plt.close(fig)
-        paths.append(path)
+        drawings = {ds.name: figure(ds, plt)}
+        if ds.name == "ricsac_runout":
+            drawings[f"{ds.name}_plan"] = runout_plan(ds, plt)
+        for name, fig in drawings.items():
+            path = directory / f"{name}.png"
+            fig.savefig(path, dpi=110, bbox_inches="tight")
+            plt.close(fig)
+            paths.append(path)
     return paths
 
 
@@ -134,4 +154,56 @@ def figure(ds: Dataset, plt):
         ax.set_aspect("equal", adjustable="box")
     fig.suptitle(ds.title, fontsize=11)
     fig.tight_layout()
+    return fig
+
+
+# markers of the rest poses in the plan view: source -> (marker, colour)
+REST_MARKS = {"measured": ("*", "k"), "SIMON": ("^", "tab:orange"), "EDSMAC4": ("s", "tab:green")}
+
+
+def runout_plan(ds: Dataset, plt):
+    """Plan view per RICSAC test (Day's frame: X right, Y down the page as in the
+    SAE frame): separation, measured, SIMON and EDSMAC4 rest positions, and the
+    run-out paths with every wheel rolling and every wheel locked; the frame is
+    fitted to the published positions, so a path that rolls far past them leaves it."""
+    table, forward = ds.tables["table"], {r["label"]: r for r in ds.tables["forward"]}
+    tests = sorted({r["label"].split(".")[0] for r in table}, key=lambda t: int(t.split("-")[1]))
+    fig, axes = plt.subplots(1, len(tests), figsize=(4.4 * len(tests), 4.6), squeeze=False)
+    for ax, test in zip(axes[0], tests):
+        rows = [r for r in table if r["label"].split(".")[0] == test]
+        xs, ys = [], []
+        for r in rows:
+            sx, sy = r["separation X"], r["separation Y"]
+            ax.plot(sx, sy, "o", mfc="none", color="tab:blue")
+            ax.annotate(r["name"], (sx, sy), fontsize=7, xytext=(3, 3), textcoords="offset points")
+            xs.append(sx)
+            ys.append(sy)
+            for source, (marker, colour) in REST_MARKS.items():
+                x, y = r[f"{source} X"], r[f"{source} Y"]
+                ax.plot(x, y, marker, color=colour, ms=9 if source == "measured" else 6)
+                xs.append(x)
+                ys.append(y)
+            run = forward.get(r["label"])
+            if run is not None:
+                for key, style in (("path", "-"), ("locked path", "--")):
+                    ax.plot(*zip(*run[key]), style, color="tab:blue", lw=1)
+        pad = 0.15 * max(max(xs) - min(xs), max(ys) - min(ys), 10.0)
+        ax.set_xlim(min(xs) - pad, max(xs) + pad)
+        ax.set_ylim(max(ys) + pad, min(ys) - pad)  # Y to the right of X: down the page
+        ax.set_aspect("equal", adjustable="box")
+        ax.set_title(f"{test} (RICSAC {rows[0]['ricsac']})", fontsize=10)
+        ax.set_xlabel("X [ft]")
+        ax.set_ylabel("Y [ft]")
+    handles = [
+        plt.Line2D([], [], marker="o", mfc="none", ls="", color="tab:blue", label="separation (read)"),
+        *(
+            plt.Line2D([], [], marker=m, ls="", color=c, label=f"rest, {s}")
+            for s, (m, c) in REST_MARKS.items()
+        ),
+        plt.Line2D([], [], ls="-", color="tab:blue", label="run-out, wheels rolling"),
+        plt.Line2D([], [], ls="--", color="tab:blue", label="run-out, wheels locked"),
+    ]
+    fig.legend(handles=handles, loc="lower center", ncol=6, fontsize=8, bbox_to_anchor=(0.5, -0.04))
+    fig.suptitle(ds.title, fontsize=11)
+    fig.tight_layout(rect=(0, 0.05, 1, 1))
     return fig

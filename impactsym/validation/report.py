@@ -25,8 +25,11 @@ from .ricsac import (
     ricsac_momentum,
     ricsac_pim,
 )
+from .runout import ASSUMED as RUNOUT_ASSUMED
+from .runout import ricsac_runout_fit, ricsac_runout_forward, ricsac_runout_table
 
 ASSUMPTIONS = {
+    "ricsac_runout": RUNOUT_ASSUMED,
     "ricsac_crash3": (
         "Damaged faces from the configuration (vehicle 1 front; vehicle 2 side, rear or front). "
         "alpha = PDOF for a front, PDOF - 180 for a rear, PDOF -/+ 90 for a side (right side "
@@ -108,6 +111,8 @@ CRASH3_ENERGIES = {
     "CRASH3 (Neades' adjustments)": "neades",
 }
 PIM = "rigid PIM (approx. impact centre)"
+RUNOUT_FORWARD = "run-out, wheels rolling (forward)"
+RUNOUT_FIT = "run-out fit to rest"
 PIM_REFERENCES = {f"measured, {v}": v for v in MEASURED_VERSIONS} | {"Brach's PIM 2002": "brach_pim_2002"}
 IIHS_QUANTITIES = {
     "delta-V": "dv",
@@ -197,6 +202,35 @@ COMPARISONS: dict[str, list[Spec]] = {
         for quantity, key in (("delta-V", "dv"), ("yaw-rate change", "yaw"))
         for reference, kind in V2V_KINDS.items()
     ],
+    "ricsac_runout": [
+        *(
+            Spec(
+                model,
+                "rest distance from separation",
+                "measured",
+                rows,
+                got,
+                "runout_distance_ft",
+                where=("free", True),
+            )
+            for model, rows, got in (
+                (RUNOUT_FORWARD, "forward", "distance_ft"),
+                ("run-out, wheels locked (bracket)", "forward", "locked distance_ft"),
+                ("SIMON (Day 2004)", "table", "SIMON distance_ft"),
+                ("EDSMAC4 (Day 2004)", "table", "EDSMAC4 distance_ft"),
+            )
+        ),
+        Spec(RUNOUT_FIT, "separation speed", "measured (Vossou 2018)", "fit", "speed", "speed_measured"),
+        Spec(
+            f"{RUNOUT_FIT}, converged",
+            "separation speed",
+            "measured (Vossou 2018)",
+            "fit",
+            "speed",
+            "speed_measured",
+            where=("converged", True),
+        ),
+    ],
     "nhtsa": [
         *(
             Spec("rigid PIM", quantity, "published PIM", "per test", key, f"{key}_published", "test")
@@ -234,7 +268,7 @@ def _run(ds: Dataset, views: dict[str, list[dict[str, Any]]]) -> Dataset:
 
 def report() -> list[Dataset]:
     """Every dataset through every model its data allow (``COMPARISONS``)."""
-    return [_ricsac(), _iihs(), _iihs_v2v(), _nhtsa()]
+    return [_ricsac(), _ricsac_runout(), _iihs(), _iihs_v2v(), _nhtsa()]
 
 
 def _pim_vehicles(solved: list[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -290,8 +324,8 @@ def _ricsac() -> Dataset:
         ASSUMPTIONS["ricsac_pim"],
         f"Vossou's measured separation velocities do not conserve momentum (worst: test "
         f"{worst['test']}, {worst['x_pct']:+.1f} % of the initial momentum in x; test 1 "
-        "to 10 between 1 and 17 %): the post-impact data are contaminated, so no model is "
-        "fitted or judged on them. Test 12's pre-impact v1y (-4.28 m/s) also looks "
+        "to 10 between 1 and 17 %): the post-impact data are contaminated, so no impact model "
+        "is fitted or judged on them (the run-out check uses them, saying so). Test 12's pre-impact v1y (-4.28 m/s) also looks "
         "suspect (the y balance is off by 76 %); the rigid PIM uses it as published.",
         IMPLAUSIBLE["7.2"],
     ]
@@ -362,4 +396,38 @@ def _nhtsa() -> Dataset:
         {"per test": rows[::2], "nhtsa": [{**r, "label": f"{r['test']} {r['vehicle']}"} for r in rows]},
     )
     ds.notes.append(ASSUMPTIONS["nhtsa"])
+    return ds
+
+
+def _ricsac_runout() -> Dataset:
+    ds = Dataset(
+        "ricsac_runout", "RICSAC rest positions (Day 2004, Table 7): the run-out, RICSAC 2, 3, 6, 10"
+    )
+    ds.tables.update(
+        {"table": list(ricsac_runout_table()), "forward": ricsac_runout_forward(), "fit": ricsac_runout_fit()}
+    )
+    _run(ds, {})
+    rolls = [r["drag_needed"] for r in ds.tables["forward"] if r["free"] and abs(r["yaw_rate"]) < 1.0]
+    spins = [r["drag_needed"] for r in ds.tables["forward"] if r["free"] and abs(r["yaw_rate"]) >= 1.0]
+    free = [r for r in ds.tables["forward"] if r["free"]]
+    inside = [
+        r["label"] for r in free if r["locked distance_ft"] <= r["runout_distance_ft"] <= r["distance_ft"]
+    ]
+    ds.notes += [
+        ASSUMPTIONS["ricsac_runout"],
+        f"Bracket (every wheel locked instead of rolling, same separation state): the measured "
+        f"run-out distance lies between the locked and the rolling prediction for {len(inside)} of "
+        f"{len(free)} free run-outs ({', '.join(inside) or 'none'}).",
+        "Measured rest and separation in Day's frame (ft, deg; SAE: Y right, heading clockwise). "
+        "Position error is the distance between predicted and measured rest; the run-out distance "
+        "is the straight line from separation to the measured rest.",
+        f"FINDING: with every wheel rolling at f_r = 0.01 the forward run-outs overshoot; a straight "
+        f"roll from the measured separation speed to the measured rest needs a drag of "
+        f"{min(rolls):.3f}-{max(rolls):.3f} g for the cars that mostly translate (|yaw rate| < 1 rad/s; "
+        f"{min(spins):.2f}-{max(spins):.2f} g for the spinning ones, which the lateral tyre forces "
+        "also stop) (column 'drag needed'): the wheel states assumed (free rolling, no engine drag, "
+        "no damaged or jammed wheels) are the weak input. The forward headings of the cars that "
+        "mostly translate are within the bound; the fit reaches the rest poses only by sliding "
+        "sideways, or does not converge.",
+    ]
     return ds
