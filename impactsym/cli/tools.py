@@ -45,9 +45,12 @@ def _run_compile(args: argparse.Namespace) -> int:
     """Compile every batch driver once for this machine, and the loops of
     exact percentiles."""
     from ..batch import selection  # imports numba: only this command needs it
+    from ..runout.batch import compile_drivers
 
     start = time.perf_counter()
-    count = _kernels.compile_all(None if args.quiet else print) + selection.compile_loops()
+    count = (
+        _kernels.compile_all(None if args.quiet else print) + selection.compile_loops() + compile_drivers()
+    )
     if not args.quiet:
         print(f"compiled or loaded {count} batch drivers and loops in {time.perf_counter() - start:.0f} s")
     return 0

@@ -110,3 +110,18 @@ def run_row(
         buffer,
     )
     return y, t, int(status), int(steps), buffer[:points]
+
+
+def compile_drivers() -> int:
+    """Compile (or load from numba's cache) every run-out driver: both batch
+    drivers and the row functions with and without sensitivities, by running
+    one locked slide through each (``impactsym compile``). Returns how many."""
+    row = {"m": 1500.0, "I": 2500.0, "L": 2.7, "a": 1.2, "track": 1.5, "mu": 0.7}
+    row |= {"x": 0.0, "y": 0.0, "psi": 0.0, "vx": 10.0, "vy": 0.0, "w": 0.0}
+    row |= {f"state_{k}": 1.0 for k in ("fl", "fr", "rl", "rr")}
+    for parallel in (True, False):
+        runout_batch(row, parallel=parallel)
+    values = input_table(row)[0]
+    for sens in (False, True):
+        run_row(values, sens=sens)
+    return 4
