@@ -188,6 +188,9 @@ WHOLE_PACKAGE_RUNS = [
     ["sample", "two_car_us.json", "--dist", "e=uniform:0:0.3", "-n", "2000", "--seed", "12", "--no-progress"],
     ["validate"],
     ["validate", "--markdown", "--plots", "figures"],
+    ["runout", "runout/sedan.json", "--json"],
+    ["fit", "fit_intersection_us.json", "--json"],
+    ["edr", "edr_cf09009b_pulse_g.csv", "--json"],
     # compiling every driver takes minutes: the installed command is checked to parse and start
     ["compile", "--help"],
 ]
@@ -220,6 +223,7 @@ def installed(dists, tmp_path_factory):
     for argv in WHOLE_PACKAGE_RUNS:
         for arg in argv:
             if (ROOT / "examples" / arg).is_file():
+                (work / arg).parent.mkdir(parents=True, exist_ok=True)
                 shutil.copy(ROOT / "examples" / arg, work / arg)
     return venv / "bin" / "impactsym", work
 
@@ -252,4 +256,5 @@ def test_every_command_runs_from_the_installed_wheel_outside_the_checkout(instal
     assert done.stdout == here.stdout
     if "--plot" in argv or "--plots" in argv:
         made = work / argv[argv.index("--plot") + 1] if "--plot" in argv else work / "figures"
-        assert made.exists() and (made.is_file() or len(list(made.glob("*.png"))) == 4)
+        theirs = len(list((mine / "figures").glob("*.png")))
+        assert made.exists() and (made.is_file() or len(list(made.glob("*.png"))) == theirs > 0)
