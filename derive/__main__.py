@@ -25,6 +25,8 @@ MODEL_MODULES = (
     "crash3",
     "report",
     "jacobian",
+    "kudlich_slibar",
+    "coulomb",
 )
 # Proved before emission but emitting no module of their own (emit inlines their source).
 PROOF_ONLY_MODULES = ("trig",)

@@ -1,0 +1,98 @@
+"""The impact laws against the independent 50-digit phase-by-phase reference
+(impactsym/testing/laws.py), and the per-scene functions against the numba drivers."""
+
+from __future__ import annotations
+
+import math
+import random
+
+import numpy as np
+import pytest
+
+from impactsym import laws
+from impactsym.laws import kernels
+from impactsym.laws._door import generated_module
+from impactsym.testing import laws as L
+
+TOL = 1e-12
+"""Largest accepted error of every output, relative to its natural scale."""
+CASES = [
+    ("kudlich_slibar", "full"),
+    ("kudlich_slibar", "sliding"),
+    ("coulomb", "newton"),
+    ("coulomb", "poisson"),
+    ("coulomb", "energetic"),
+]
+
+
+def _worst(model, law, c):
+    """(largest error over rows and outputs, its output, slip-class / contact mismatches)."""
+    out = kernels.run_batch(model, law, c)
+    assert np.all(out["status"] == 0)
+    worst, where, mismatched = 0.0, None, 0
+    for i in range(len(c["e"])):
+        row = L.row_of(c, i)
+        if model == "coulomb":
+            ref = L.coulomb_reference(row, law)
+            mismatched += ref["slip_class"] != out["slip_class"][i]
+        else:
+            ref = L.kudlich_slibar_reference(row, law)
+            mismatched += ref["sliding"] != out["sliding"][i]
+        errors = L.errors_against({k: out[k][i] for k in L.OUTPUTS}, ref, row)
+        key = max(errors, key=errors.get)
+        if errors[key] > worst:
+            worst, where = errors[key], (i, key)
+    return worst, where, mismatched
+
+
+@pytest.mark.parametrize("model, law", CASES)
+@pytest.mark.parametrize("which", ["realistic", "stress"])
+def test_every_output_within_1e_12_of_scale(model, law, which):
+    c = L.realistic(400, 31) if which == "realistic" else L.stress(400, 32)
+    worst, where, mismatched = _worst(model, law, c)
+    print(f"\n{which} {model} {law}: worst {worst:.2e} at {where}")
+    assert worst <= TOL, (worst, where)
+    assert mismatched == 0
+
+
+def test_the_reference_sees_every_slip_class():
+    """The stress set exercises continuing, stopping and reversing slip."""
+    c = L.stress(400, 32)
+    classes = {L.coulomb_reference(L.row_of(c, i), "newton")["slip_class"] for i in range(len(c["e"]))}
+    assert classes == {0, 1, 2}
+
+
+@pytest.mark.parametrize("model, law", CASES)
+def test_per_scene_function_and_drivers_give_the_same_bits(model, law):
+    c = L.stress(300, 41)
+    whole = kernels.run_batch(model, law, c)  # >= PYTHON_BELOW rows: the numba driver
+    for start in range(0, 200, 50):
+        part = kernels.run_batch(model, law, {k: v[start : start + 50] for k, v in c.items()})
+        for key, value in part.items():
+            assert np.array_equal(value, whole[key][start : start + 50], equal_nan=True), key
+
+
+@pytest.mark.parametrize("module", ["kudlich_slibar", "coulomb"])
+def test_per_scene_functions_never_raise(module):
+    """Any mix of zeros, signs, infinities, NaN and extreme magnitudes gives a row."""
+    mod = generated_module(module)
+    values = (0.0, -0.0, -1.0, 1.0, 2.5, -3.0, math.inf, -math.inf, math.nan, 1e-300, 1e300, 5e-324)
+    rng = random.Random(7)
+    for name, row in mod.MANIFEST.items():
+        function = getattr(mod, name)
+        for _ in range(3000):
+            args = [rng.choice(values) for _ in row["arguments"]]
+            assert len(function(*args)) == len(row["outputs"]) + 2, (name, args)
+
+
+def test_bad_rows_get_a_status_and_leave_the_others():
+    c = L.realistic(100, 5)
+    c["m1"][3] = -1.0
+    c["e"][5] = math.nan
+    c["mu_f"][7] = -0.2
+    out = laws.coulomb_batch(c, "newton")
+    assert out["status"][3] == 2 and out["status"][5] == 1 and out["status"][7] == 14
+    assert np.isnan(out["Pn"][[3, 5, 7]]).all()
+    assert np.all(out["status"][[0, 1, 2, 4, 6, 8]] == 0)
+    with pytest.raises(ValueError, match="mu_f"):
+        laws.coulomb_batch({k: v for k, v in c.items() if k != "mu_f"}, "newton")
