@@ -378,3 +378,28 @@ def test_cli_solve_json_and_bad_scene(tmp_path):
     proc = subprocess.run(run + [str(bad), "--json"], capture_output=True, text=True, env=env, timeout=120)
     assert proc.returncode == 2 and "impact.friction" in proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_compare_a_law_scene_reads_it_in_brachs_terms():
+    """A K–S scene in compare: a row per law its data allow, and the seed's models at
+    e = eps and mu = the K–S ratio, so the brach row is the K–S impulse."""
+    scene = dict(SCENE, model="kudlich_slibar")
+    scene["impact"] = {"normal_angle": 10.0, "restitution": 0.3, "contact": "full", "friction": 0.5}
+    with pytest.raises(impactsym.SceneError, match="impact.friction"):
+        impactsym.solve(scene)  # a full contact takes no friction
+    scene["impact"]["contact"] = "sliding"
+    rows = {row["model"]: row for row in impactsym.compare(scene).to_json_dict()["models"]}
+    assert {
+        "brach",
+        "kudlich_slibar (full)",
+        "kudlich_slibar (sliding)",
+        "coulomb (newton)",
+        "coulomb (poisson)",
+        "coulomb (energetic)",
+    } <= set(rows)
+    own = rows["kudlich_slibar (sliding)"]
+    assert rows["brach"]["impulse_ratio"] == own["impulse_ratio"]
+    for a, b in zip(rows["brach"]["vehicles"], own["vehicles"]):
+        assert a["velocity"] == pytest.approx(b["velocity"], rel=1e-12, abs=1e-12)
+    assert rows["brach"]["energy_loss"]["total"] == pytest.approx(own["energy_loss"]["total"], rel=1e-12)
+    assert own["energy_loss"]["moment"] is None
