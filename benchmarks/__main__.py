@@ -23,6 +23,7 @@ SUBCOMMANDS = {
     "performance": "benchmarks.performance",
     "uncertainty": "benchmarks.uncertainty",
     "trig": "benchmarks.trig",
+    "laws": "benchmarks.laws",
 }
 
 

@@ -20,6 +20,7 @@ import numpy as np
 from . import _kernels
 from ._util import require
 from .batch import solve_batch
+from .laws.scene import is_law_scene, load_law_scene
 from .scene import CRITICAL, load_scene, show_value
 
 __all__ = [
@@ -62,6 +63,9 @@ class _Base:
 
     @classmethod
     def load(cls, scene) -> _Base:
+        if is_law_scene(scene):  # impactsym.laws: model "coulomb:energetic" etc., nothing fixed
+            law = load_law_scene(scene)
+            return cls(f"{law.model}:{law.law}", law.scene.units, law.inputs(), {})
         scene = load_scene(scene)
         _, critical, values = scene.to_inputs()
         _, fixed = _kernels.preset(scene.model)

@@ -31,6 +31,7 @@ from . import _kernels
 from ._util import CHUNK_SIZE, is_dataframe, row_count, spans
 from .casefile import unknown_key
 from .dask_engine import map_chunks
+from .laws.dispatch import is_law_model, solve_law_batch
 from .scene import CRITICAL
 
 #: Scene-file words for batch columns: a near miss of one suggests its column.
@@ -212,6 +213,8 @@ def solve_batch(columns, model="rigid", outputs=None, engine: str = "local"):
     """
     names, tier = _kernels.requested_outputs(outputs)
     require_mapping(columns)
+    if is_law_model(model):  # "kudlich_slibar[:contact]", "coulomb[:law]": impactsym.laws
+        return _like(columns, solve_law_batch(columns, model, names))
     if engine == "dask":
         return solve_batch_dask(columns, model=model, outputs=outputs)
     if engine != "local":

@@ -403,3 +403,24 @@ def test_compare_a_law_scene_reads_it_in_brachs_terms():
         assert a["velocity"] == pytest.approx(b["velocity"], rel=1e-12, abs=1e-12)
     assert rows["brach"]["energy_loss"]["total"] == pytest.approx(own["energy_loss"]["total"], rel=1e-12)
     assert own["energy_loss"]["moment"] is None
+
+
+def test_solve_batch_sweep_and_sample_take_the_laws(realistic):
+    """impactsym.solve_batch(model="coulomb:energetic") is the laws' batch; sweep and
+    sample of a law scene vary its inputs (mu_f, restitution) through it."""
+    c = {k: v[:200] for k, v in realistic.items()}
+    out = impactsym.solve_batch(c, model="coulomb:energetic")
+    own = laws.coulomb_batch(c, "energetic")
+    assert out["status"].dtype == np.int32 and np.array_equal(out["slip_class"], own["slip_class"])
+    assert np.array_equal(out["TL"], own["TL"])
+    assert "V1x" in impactsym.solve_batch(c, model="kudlich_slibar:sliding", outputs="velocities")
+    with pytest.raises(ValueError, match="unknown law"):
+        impactsym.solve_batch(c, model="coulomb:kane")
+    frame = impactsym.sweep(SCENE, mu_f=[0.0, 0.5], restitution=[0.1, 0.4])
+    assert len(frame) == 4 and (frame["status"] == 0).all() and "slip_class" in frame
+    assert (frame["TLt"][frame["mu_f"] == 0.0] == 0.0).all()
+    single = impactsym.solve(dict(SCENE, impact=dict(SCENE["impact"], friction=0.5, restitution=0.4)))
+    row = frame[(frame["mu_f"] == 0.5) & (frame["restitution"] == 0.4)].iloc[0]
+    assert row["TL"] == single.TL
+    drawn = impactsym.sample(SCENE, {"mu_f": ("uniform", 0.0, 1.5)}, 300, seed=3)
+    assert (drawn["status"] == 0).all() and set(drawn["slip_class"]) <= {0, 1, 2}

@@ -1,0 +1,110 @@
+"""Batch kernels of the impact laws against the memory ceiling and Brach's rigid kernel.
+
+``python -m benchmarks laws [--n 200000] [--repeat 7] [--first-use]``
+
+Rows: ``impactsym.testing.laws.realistic`` (approaching passenger-car scenes with
+friction 0-1.2). Timed interleaved, the order rotating each repeat: the memory
+ceiling of each call (``benchmarks.performance.ceiling_call``: a trivial ``prange``
+kernel reading the same input arrays and writing as many outputs), Brach's rigid
+kernel (``impactsym.solve_batch(model="rigid")`` at e_m = 1 and mu = the friction
+with the sign opposing the slip), and every law through ``impactsym.solve_batch``.
+Reported per call: ns/row (median), ceiling time / call time (median of the per-repeat
+ratios) and call time / rigid time. ``--first-use``: the first ``solve_batch`` of each
+law module in a fresh process with an empty numba cache (compile included), seconds.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+DESCRIPTION = "impact-law batch kernels against the memory ceiling and the rigid kernel"
+LAWS = ("kudlich_slibar", "kudlich_slibar:sliding", "coulomb", "coulomb:poisson", "coulomb:energetic")
+N_OUT = 20  # outputs a law call returns (17 of solve_batch, status, flags, its class)
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("--n", type=int, default=200_000)
+    parser.add_argument("--repeat", type=int, default=7)
+    parser.add_argument("--first-use", action="store_true")
+
+
+def _rows(n: int) -> dict:
+    from impactsym.testing import laws
+
+    c = laws.realistic(int(n * 1.3) + 100, 2026)
+    return {k: np.ascontiguousarray(v[:n]) for k, v in c.items()}
+
+
+def main(args) -> int:
+    import impactsym
+
+    from .performance import ceiling_call
+
+    c = _rows(args.n)
+    n = len(c["e"])
+    rigid = {k: v for k, v in c.items() if k != "mu_f"}
+    gt_sign = np.sign(impactsym.laws.coulomb_batch({k: v[:n] for k, v in c.items()}, "newton")["Pt"])
+    rigid.update(mu=np.ascontiguousarray(gt_sign * c["mu_f"]), e_m=np.ones(n))
+    calls = {"rigid (Brach)": lambda: impactsym.solve_batch(rigid, model="rigid")}
+    ceilings = {"rigid (Brach)": ceiling_call(rigid, 19)}
+    for law in LAWS:
+        cols = c if law != "kudlich_slibar" else {k: v for k, v in c.items() if k != "mu_f"}
+        calls[law] = lambda cols=cols, law=law: impactsym.solve_batch(cols, model=law)
+        ceilings[law] = ceiling_call(cols, N_OUT)
+    for fn in list(calls.values()) + list(ceilings.values()):
+        fn()  # compile / warm
+    times = {name: [] for name in calls}
+    ceil = {name: [] for name in calls}
+    names = list(calls)
+    for r in range(args.repeat):
+        for name in names[r % len(names) :] + names[: r % len(names)]:
+            t0 = time.perf_counter()
+            ceilings[name]()
+            t1 = time.perf_counter()
+            calls[name]()
+            t2 = time.perf_counter()
+            ceil[name].append(t1 - t0)
+            times[name].append(t2 - t1)
+    base = statistics.median(times["rigid (Brach)"])
+    print(f"rows {n}, repeats {args.repeat}, cpus {os.cpu_count()} (shared machine)")
+    print(f"{'call':<26}{'ns/row':>10}{'ceiling/call':>14}{'call/rigid':>12}")
+    report = {}
+    for name in names:
+        t = statistics.median(times[name])
+        ratio = statistics.median(a / b for a, b in zip(ceil[name], times[name]))
+        report[name] = {"ns_per_row": 1e9 * t / n, "ceiling_over_call": ratio, "over_rigid": t / base}
+        print(f"{name:<26}{1e9 * t / n:>10.1f}{ratio:>14.2f}{t / base:>12.2f}")
+    if args.first_use:
+        report["first_use_s"] = _first_use()
+    print(json.dumps(report, indent=1))
+    return 0
+
+
+def _first_use() -> dict:
+    """Seconds of the first solve_batch per law module in a fresh process, empty cache."""
+    code = (
+        "import time, impactsym; from impactsym.testing import laws; c = laws.realistic(300, 1); "
+        "t = time.perf_counter(); impactsym.solve_batch(c, model=MODEL); print(time.perf_counter() - t)"
+    )
+    out = {}
+    for model in ("kudlich_slibar:sliding", "coulomb:energetic"):
+        with tempfile.TemporaryDirectory() as cache:
+            env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+            proc = subprocess.run(
+                [sys.executable, "-c", code.replace("MODEL", repr(model))],
+                capture_output=True,
+                text=True,
+                env=env,
+                timeout=600,
+            )
+            out[model] = float(proc.stdout.strip().splitlines()[-1]) if proc.returncode == 0 else proc.stderr
+        print(f"first use {model}: {out[model]}")
+    return out
