@@ -9,8 +9,9 @@ kernel reading the same input arrays and writing as many outputs), Brach's rigid
 kernel (``impactsym.solve_batch(model="rigid")`` at e_m = 1 and mu = the friction
 with the sign opposing the slip), and every law through ``impactsym.solve_batch``.
 Reported per call: ns/row (median), ceiling time / call time (median of the per-repeat
-ratios) and call time / rigid time. ``--first-use``: the first ``solve_batch`` of each
-law module in a fresh process with an empty numba cache (compile included), seconds.
+ratios) and call time / rigid time. ``--first-use``: the first ``solve_batch`` of a law in a
+fresh process with an empty numba cache, 300 rows (per-scene functions, no compile) and
+20,000 rows (the parallel driver compiles), seconds.
 """
 
 from __future__ import annotations
@@ -89,22 +90,26 @@ def main(args) -> int:
 
 
 def _first_use() -> dict:
-    """Seconds of the first solve_batch per law module in a fresh process, empty cache."""
+    """Seconds of the first solve_batch of a law in a fresh process with an empty numba
+    cache: 300 rows (within the per-scene budget: no compile) and 20,000 rows (the
+    parallel driver compiles)."""
     code = (
-        "import time, impactsym; from impactsym.testing import laws; c = laws.realistic(300, 1); "
+        "import time, impactsym; from impactsym.testing import laws; c = laws.realistic(ROWS, 1); "
         "t = time.perf_counter(); impactsym.solve_batch(c, model=MODEL); print(time.perf_counter() - t)"
     )
     out = {}
     for model in ("kudlich_slibar:sliding", "coulomb:energetic"):
-        with tempfile.TemporaryDirectory() as cache:
-            env = dict(os.environ, NUMBA_CACHE_DIR=cache)
-            proc = subprocess.run(
-                [sys.executable, "-c", code.replace("MODEL", repr(model))],
-                capture_output=True,
-                text=True,
-                env=env,
-                timeout=600,
-            )
-            out[model] = float(proc.stdout.strip().splitlines()[-1]) if proc.returncode == 0 else proc.stderr
-        print(f"first use {model}: {out[model]}")
+        for rows in (300, 20_000):
+            with tempfile.TemporaryDirectory() as cache:
+                env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+                proc = subprocess.run(
+                    [sys.executable, "-c", code.replace("MODEL", repr(model)).replace("ROWS", str(rows))],
+                    capture_output=True,
+                    text=True,
+                    env=env,
+                    timeout=600,
+                )
+            key = f"{model}, {rows} rows"
+            out[key] = float(proc.stdout.strip().splitlines()[-1]) if proc.returncode == 0 else proc.stderr
+            print(f"first use {key}: {out[key]}")
     return out

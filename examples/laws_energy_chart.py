@@ -43,17 +43,19 @@ def curves(mu):
 def main(path: str) -> None:
     mu = np.linspace(0.0, 1.2, 49)
     out = curves(mu)
-    fig, ax = plt.subplots(figsize=(7, 4.2))
-    for name, res in out.items():
-        style = "--" if name.startswith("K-S") else (":" if name.startswith("Brach") else "-")
-        ax.plot(mu, res["TL"] / 1e3, style, label=name)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     rev = out["Coulomb, newton"]["slip_class"] == 2
-    if rev.any():
-        ax.axvspan(mu[rev].min(), mu[rev].max(), color="0.9", zorder=0, label="Coulomb: slip reverses")
-    ax.set_xlabel("friction coefficient at the impact centre")
-    ax.set_ylabel("energy loss T_L [kJ]")
-    ax.set_title("corner_barrier_coulomb.json: energy loss against friction")
-    ax.legend(fontsize=8)
+    for ax, names in zip(axes, (list(out), [n for n in out if not n.startswith("Brach")])):
+        for name in names:
+            style = "--" if name.startswith("K-S") else (":" if name.startswith("Brach") else "-")
+            ax.plot(mu, out[name]["TL"] / 1e3, style, label=name)
+        if rev.any():
+            ax.axvspan(mu[rev].min(), mu[rev].max(), color="0.9", zorder=0, label="Coulomb: slip reverses")
+        ax.set_xlabel("friction coefficient at the impact centre")
+        ax.set_ylabel("energy loss T_L [kJ]")
+    axes[0].set_title("corner_barrier_coulomb.json", fontsize=10)
+    axes[1].set_title("the laws alone (zoom)", fontsize=10)
+    axes[0].legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     print("mu     " + "  ".join(f"{name:>20}" for name in out))

@@ -63,11 +63,18 @@ def test_the_reference_sees_every_slip_class():
 
 
 @pytest.mark.parametrize("model, law", CASES)
-def test_per_scene_function_and_drivers_give_the_same_bits(model, law):
+def test_per_scene_function_and_drivers_give_the_same_bits(model, law, monkeypatch):
     c = L.stress(300, 41)
-    whole = kernels.run_batch(model, law, c)  # >= PYTHON_BELOW rows: the numba driver
+    monkeypatch.setattr(kernels, "PYTHON_BUDGET", 0)
+    whole = kernels.run_batch(model, law, c)  # the parallel numba driver
+    serial = kernels.run_batch(model, law, {k: v[:50] for k, v in c.items()})  # the serial one
+    monkeypatch.setattr(kernels, "PYTHON_BUDGET", 10**9)
+    monkeypatch.setattr(kernels, "_loaded", set())
     for start in range(0, 200, 50):
         part = kernels.run_batch(model, law, {k: v[start : start + 50] for k, v in c.items()})
+        if start == 0:
+            for key, value in serial.items():
+                assert np.array_equal(value, part[key], equal_nan=True), key
         for key, value in part.items():
             assert np.array_equal(value, whole[key][start : start + 50], equal_nan=True), key
 

@@ -34,8 +34,16 @@ SLIP_CLASSES = ("continues", "stops", "reverses")
 #: Kernel output names the runtime renames.
 _RENAME = {"slide": "sliding"}
 _INTEGER = ("status", "flags", "sliding", "slip_class")
-#: Rows below which a batch runs the per-scene function (no numba load) and the serial driver.
-PYTHON_BELOW = 64
+#: Rows below which a batch runs the serial driver, not the parallel one.
+SERIAL_BELOW = 64
+#: A process's first PYTHON_BUDGET rows of a law's batches run through its per-scene
+#: function (plain Python, ~20 us a row, the same bits as the drivers: tested) while its
+#: numba drivers are not loaded: compiling them on a machine with an empty cache takes
+#: 7-17 s (measured, shared 2-core machine), so a first small batch (a sweep of a few
+#: hundred points) does not wait for it. Once used up, the drivers load.
+PYTHON_BUDGET = 10_000
+_python_rows: dict[str, int] = {}  # rows run in Python per generated module
+_loaded: set[str] = set()  # generated modules whose drivers were called
 
 
 def _entry(model: str, law: str) -> tuple:
@@ -103,7 +111,8 @@ def run_batch(model: str, law: str, columns: Mapping) -> dict:
     n = lengths.pop() if lengths else 1
     values = {k: np.ascontiguousarray(np.broadcast_to(v, (n,))) for k, v in values.items()}
     outputs = _outputs(module, name)
-    if n < PYTHON_BELOW:
+    if module not in _loaded and _python_rows.get(module, 0) + n <= PYTHON_BUDGET:
+        _python_rows[module] = _python_rows.get(module, 0) + n
         rows = [solve_one(model, law, {k: v[i] for k, v in values.items()}) for i in range(n)]
         out = {key: np.array([r[key] for r in rows], dtype=np.float64) for key in outputs + ("M", "TLm")}
         out["status"] = np.array([r["status"] for r in rows], dtype=np.int64)
@@ -111,7 +120,8 @@ def run_batch(model: str, law: str, columns: Mapping) -> dict:
     else:
         jit = generated_module(module, jit=True)
         outs = [np.empty(n) for _ in outputs] + [np.empty(n, dtype=np.float64), np.empty(n)]
-        driver = getattr(jit, f"{name}_batch")
+        _loaded.add(module)
+        driver = getattr(jit, f"{name}_batch" + ("_serial" if n < SERIAL_BELOW else ""))
         driver(*(values[k] for k in names), *outs)
         out = dict(zip(outputs, outs[: len(outputs)]))
         out["status"] = outs[-2].astype(np.int64)
