@@ -424,3 +424,27 @@ def test_solve_batch_sweep_and_sample_take_the_laws(realistic):
     assert row["TL"] == single.TL
     drawn = impactsym.sample(SCENE, {"mu_f": ("uniform", 0.0, 1.5)}, 300, seed=3)
     assert (drawn["status"] == 0).all() and set(drawn["slip_class"]) <= {0, 1, 2}
+
+
+def test_uncertainty_of_a_law_scene():
+    """--uncertainty propagates a law scene's distributions through the law's batch
+    (Monte Carlo; no exact Jacobian kernel, so sd_linear is null)."""
+    from impactsym.propagation import uncertainty
+
+    scene = {
+        "model": "coulomb",
+        "units": "SI",
+        "impact": {
+            "normal_angle": {"normal": [10.0, 2.0]},
+            "restitution": {"uniform": [0.2, 0.4]},
+            "friction": 0.8,
+            "restitution_law": "energetic",
+        },
+        "vehicles": SCENE["vehicles"],
+    }
+    u = uncertainty(scene, draws=500, seed=4).to_json_dict()
+    assert u["accepted"] == 500 and set(u["inputs"]) == {"impact.normal_angle", "impact.restitution"}
+    total = u["outputs"]["energy_loss.total"]
+    nominal = impactsym.solve(scene).TL
+    assert total["nominal"] == nominal and total["p5"] < nominal < total["p95"]
+    assert total["sd_linear"] is None
