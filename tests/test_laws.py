@@ -448,3 +448,24 @@ def test_uncertainty_of_a_law_scene():
     nominal = impactsym.solve(scene).TL
     assert total["nominal"] == nominal and total["p5"] < nominal < total["p95"]
     assert total["sd_linear"] is None
+
+
+def test_cli_compare_and_sweep_take_a_law_scene():
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    scene = str(Path(__file__).resolve().parents[1] / "examples" / "corner_barrier_coulomb.json")
+    run = [sys.executable, "-m", "impactsym"]
+    proc = subprocess.run(run + ["compare", scene, "--json"], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    models = [row["model"] for row in json.loads(proc.stdout)["models"]]
+    assert "coulomb (energetic)" in models and "brach" in models
+    proc = subprocess.run(
+        run + ["sweep", scene, "--vary", "mu_f=0,0.4,0.8", "--no-progress"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert proc.returncode == 0 and "rows 3: solved 3" in proc.stdout, proc.stdout + proc.stderr
