@@ -469,3 +469,15 @@ def test_cli_compare_and_sweep_take_a_law_scene():
         timeout=300,
     )
     assert proc.returncode == 0 and "rows 3: solved 3" in proc.stdout, proc.stdout + proc.stderr
+
+
+def test_pim_to_ks_says_when_there_is_no_ks_equivalent(realistic):
+    """Brach's mu along the slip (the wrong sign for K-S's friction) has no K-S
+    equivalent unless it is the full impact's ratio: exact is false there."""
+    c = {k: v for k, v in realistic.items() if k != "mu_f"}
+    full = laws.kudlich_slibar_batch(c, "full")
+    (gn, gt), _ = _relative_motion(realistic, full)
+    mu = 0.5 * np.sign(gt) * np.abs(full["mu"])  # drags vehicle 1 against the slip
+    back = laws.pim_to_ks(dict(c, mu=mu, e_m=1.0))
+    rows = (back["status"] == 0) & (np.abs(full["mu"]) > 1e-3)
+    assert rows.sum() > 100 and not back["exact"][rows].any()
