@@ -71,6 +71,7 @@ from typing import Any
 from ._util import require
 from .codes import FLAG_ENERGY_CREATED, FLAG_MU_BEYOND_CRITICAL, FLAG_TENSILE_IMPULSE
 from .crash3 import Crash3Result
+from .laws.scene import is_law_scene, load_law_scene
 from .plot_crash3 import save_crash3
 from .plot_sweep import save_sweep, sweep
 from .result import UNIT_LABELS
@@ -280,6 +281,8 @@ def _resolve(obj: Any, scene: SceneLike | None, result: Any) -> tuple[Scene, Any
     if result is not None and not hasattr(result, "vehicles"):
         raise TypeError(f"plot: expected a result with vehicles, got {type(result).__name__}")
     kind = _SCENE_KINDS.get(str(getattr(result, "kind", "solve")), "forward")
+    if is_law_scene(scene):  # impactsym.laws: drawn as its rigid reading
+        return load_law_scene(scene).scene, result, _impact_position(scene)
     return load_scene(scene, kind=kind), result, _impact_position(scene)
 
 
@@ -1106,6 +1109,12 @@ def _title(scene: Scene, result: Any) -> str:
         f"{name}: {scene.model} model, {scene.units}; Γ = {impact.normal_angle:g}°, "
         f"e = {impact.restitution:g}, {mu}{em}"
     )
+    if getattr(result, "law", None):  # impactsym.laws: the law, not its rigid reading
+        friction = "" if result.friction is None else f", friction {result.friction:g}"
+        head = (
+            f"{name}: {result.model} ({result.law}{friction}), {scene.units}; "
+            f"Γ = {impact.normal_angle:g}°, e = {impact.restitution:g}"
+        )
     if getattr(result, "kind", None) == "reconstruct":
         head = (
             f"{name}: reconstruction, {scene.units}; Γ = {impact.normal_angle:g}°, implied e = {result.e:.3g}, "

@@ -481,3 +481,16 @@ def test_pim_to_ks_says_when_there_is_no_ks_equivalent(realistic):
     back = laws.pim_to_ks(dict(c, mu=mu, e_m=1.0))
     rows = (back["status"] == 0) & (np.abs(full["mu"]) > 1e-3)
     assert rows.sum() > 100 and not back["exact"][rows].any()
+
+
+def test_plot_of_a_law_scene_names_the_law(tmp_path):
+    pytest.importorskip("matplotlib")
+    from impactsym.plot import _title, save_plot
+
+    result = impactsym.solve(SCENE)
+    out = save_plot(result, tmp_path / "law.png", scene=SCENE)
+    assert out.exists() and out.stat().st_size > 10_000
+    from impactsym.laws.scene import load_law_scene
+
+    title = _title(load_law_scene(SCENE).scene, result)
+    assert "coulomb (energetic, friction 0.8)" in title and "rigid" not in title

@@ -89,7 +89,7 @@ def solve_one(model: str, law: str, values: Mapping[str, float]) -> dict:
     return _finish(out)
 
 
-def _column(columns: Mapping, key: str, n: int | None):
+def _column(columns: Mapping, key: str):
     """One input column as a float64 array (a scalar is broadcast later)."""
     if key not in columns:
         raise ValueError(f"columns: missing input column {key!r}")
@@ -104,7 +104,7 @@ def run_batch(model: str, law: str, columns: Mapping) -> dict:
     scalars; returns a dict of arrays (outputs, `status`, `flags`)."""
     module, name = _entry(model, law)
     names = columns_of(model, law)
-    values = {key: _column(columns, key, None) for key in names}
+    values = {key: _column(columns, key) for key in names}
     lengths = {v.shape[0] for v in values.values() if v.ndim == 1}
     if len(lengths) > 1:
         raise ValueError(f"columns: arrays of different lengths {sorted(lengths)}")
