@@ -9,7 +9,8 @@ kernel reading the same input arrays and writing as many outputs), Brach's rigid
 kernel (``impactsym.solve_batch(model="rigid")`` at e_m = 1 and mu = the friction
 with the sign opposing the slip), and every law through ``impactsym.solve_batch``.
 Reported per call: ns/row (median), ceiling time / call time (median of the per-repeat
-ratios) and call time / rigid time. ``--first-use``: the first ``solve_batch`` of a law in a
+ratios) and call time / rigid time; then the bodies on one thread (serial drivers called
+directly, least of 7) against Brach's point-impulse kernel ``rigid_em1``. ``--first-use``: the first ``solve_batch`` of a law in a
 fresh process with an empty numba cache, 300 rows (per-scene functions, no compile) and
 20,000 rows (the parallel driver compiles), seconds.
 """
@@ -83,10 +84,50 @@ def main(args) -> int:
         ratio = statistics.median(a / b for a, b in zip(ceil[name], times[name]))
         report[name] = {"ns_per_row": 1e9 * t / n, "ceiling_over_call": ratio, "over_rigid": t / base}
         print(f"{name:<26}{1e9 * t / n:>10.1f}{ratio:>14.2f}{t / base:>12.2f}")
+    report["serial_ns_per_row"] = _serial(c)
     if args.first_use:
         report["first_use_s"] = _first_use()
     print(json.dumps(report, indent=1))
     return 0
+
+
+def _serial(c: dict) -> dict:
+    """The kernels' bodies on one thread: each law's serial driver called directly on
+    preallocated outputs, least of 7, against Brach's point-impulse kernel (rigid_em1)."""
+    import generated.planar as plain_rigid
+    import generated.planar_jit as jit_rigid
+    from impactsym.laws._door import generated_module
+
+    n = len(c["e"])
+
+    def least(run):
+        run()
+        times = []
+        for _ in range(7):
+            t0 = time.perf_counter()
+            run()
+            times.append(time.perf_counter() - t0)
+        return 1e9 * min(times) / n
+
+    def driver(module_plain, module_jit, name, cols):
+        m = module_plain.MANIFEST[name]
+        ins = [np.ascontiguousarray(cols[k]) for k in m["columns"]]
+        outs = [np.empty(n) for _ in range(len(m["outputs"]) + 2)]
+        fn = getattr(module_jit, f"{name}_batch_serial")
+        return lambda: fn(*ins, *outs)
+
+    out = {"rigid_em1": least(driver(plain_rigid, jit_rigid, "rigid_em1", dict(c, mu=c["mu_f"], e_m=1.0)))}
+    for module, names in (
+        ("kudlich_slibar", ("ks_full", "ks_sliding")),
+        ("coulomb", ("coulomb_newton", "coulomb_poisson", "coulomb_energetic")),
+    ):
+        plain, jit = generated_module(module), generated_module(module, jit=True)
+        for name in names:
+            out[name] = least(driver(plain, jit, name, c))
+    print("one thread, serial drivers (ns/row, x rigid_em1):")
+    for name, value in out.items():
+        print(f"  {name:<20}{value:>8.1f}{value / out['rigid_em1']:>8.2f}")
+    return out
 
 
 def _first_use() -> dict:
