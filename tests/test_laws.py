@@ -494,3 +494,22 @@ def test_plot_of_a_law_scene_names_the_law(tmp_path):
 
     title = _title(load_law_scene(SCENE).scene, result)
     assert "coulomb (energetic, friction 0.8)" in title and "rigid" not in title
+
+
+def test_friction_may_be_uncertain():
+    """impact.friction is a leaf like any other: a distribution is drawn, and a
+    draw below 0 is rejected with its reason."""
+    from impactsym.propagation import uncertainty
+
+    scene = dict(SCENE, impact=dict(SCENE["impact"], friction={"normal": [0.5, 0.3]}))
+    nominal = impactsym.solve(scene)
+    assert nominal.friction == 0.5
+    u = uncertainty(scene, draws=2000, seed=5).to_json_dict()
+    assert u["inputs"] == ["impact.friction"]
+    assert 0 < sum(u["rejected"].values()) < 200 and u["accepted"] + sum(u["rejected"].values()) == 2000
+    assert any("impact.friction" in reason for reason in u["rejected"])
+    both = dict(scene, impact=dict(scene["impact"], restitution={"uniform": [0.2, 0.4]}))
+    u = uncertainty(both, draws=500, seed=6).to_json_dict()
+    assert set(u["inputs"]) == {"impact.friction", "impact.restitution"}
+    with pytest.raises(impactsym.SceneError, match="impact.friction"):
+        impactsym.solve(dict(SCENE, impact=dict(SCENE["impact"], friction="0.5 m")))

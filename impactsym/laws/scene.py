@@ -17,14 +17,14 @@ strings, vehicles, fixed bodies, the sense of the normal) is read by
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ..casefile import Leaf, LeafReader
 from ..errors import SceneError, show_value
-from ..scene import Scene, _read_file, load_scene
+from ..scene import Scene, _read_file, load_scene, scene_columns
 from .kernels import DEFAULT_LAW, LAWS
 
 LAW_MODELS = tuple(LAWS)
@@ -44,6 +44,15 @@ class LawScene:
     law: str
     friction: float | None
     warnings: tuple[str, ...]
+    friction_leaf: Leaf | None = None
+
+    @property
+    def uncertain(self) -> tuple[tuple[str, str, tuple[float, ...]], ...]:
+        """The scene's uncertain leaves, ``impact.friction`` included when it is a
+        distribution (as :attr:`impactsym.scene.Scene.uncertain`)."""
+        leaf = self.friction_leaf
+        own = () if leaf is None or leaf.kind is None else ((leaf.path, leaf.kind, leaf.params),)
+        return self.scene.uncertain + own
 
     def inputs(self) -> dict[str, float]:
         """The law kernel's inputs (batch names; gamma in radians)."""
@@ -91,12 +100,13 @@ def load_law_scene(source: Any) -> LawScene:
         raise SceneError("required", "impact.restitution")
     impact.update(impulse_ratio=0.0, moment_restitution=1.0)
     scene = load_scene(dict(data, model="rigid", impact=impact))
-    law, friction = _law(model, own)
-    return LawScene(scene, model, law, friction, tuple(warnings))
+    law, leaf = _law(model, own, scene.units)
+    friction = None if leaf is None else leaf.nominal
+    return LawScene(scene, model, law, friction, tuple(warnings), leaf)
 
 
-def _law(model: str, own: Mapping) -> tuple[str, float | None]:
-    """(law, friction) of the scene's law keys."""
+def _law(model: str, own: Mapping, units: str) -> tuple[str, Leaf | None]:
+    """(law, friction leaf) of the scene's law keys."""
     if model == "kudlich_slibar":
         if "restitution_law" in own:
             raise SceneError(
@@ -110,11 +120,11 @@ def _law(model: str, own: Mapping) -> tuple[str, float | None]:
                     'not used by a "full" contact (give "contact": "sliding")', "impact.friction"
                 )
             return law, None
-        return law, _friction(own)
+        return law, _friction(own, units)
     if "contact" in own:
         raise SceneError("unknown key for the coulomb model", "impact.contact")
     law = _choice(own.get("restitution_law", DEFAULT_LAW[model]), "impact.restitution_law", LAWS[model])
-    return law, _friction(own)
+    return law, _friction(own, units)
 
 
 def _choice(value: Any, path: str, allowed: tuple[str, ...]) -> str:
@@ -123,16 +133,33 @@ def _choice(value: Any, path: str, allowed: tuple[str, ...]) -> str:
     return value
 
 
-def _friction(own: Mapping) -> float:
-    """impact.friction: a finite number ≥ 0 (required)."""
+def _friction(own: Mapping, units: str) -> Leaf:
+    """impact.friction: a plain number ≥ 0 (or a distribution of one, as any
+    numeric leaf), read as a case-file leaf; required."""
     if "friction" not in own:
-        raise SceneError("required (the friction coefficient at the impact centre)", "impact.friction")
-    value = own["friction"]
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, (int, float))
-        or not math.isfinite(value)
-        or value < 0
-    ):
-        raise SceneError(f"must be a finite number >= 0, got {show_value(value)}", "impact.friction")
-    return float(value)
+        raise SceneError(
+            "required (the friction coefficient at the impact centre)",
+            "impact.friction",
+        )
+    reader = LeafReader(units)
+    reader.number(own["friction"], "impact.friction", "number", "nonnegative")
+    return reader.leaves["impact.friction"]
+
+
+def law_columns(law_scene: LawScene, overrides: Mapping[str, Any]) -> tuple[dict, Any]:
+    """Kernel columns of a law scene with leaves overridden (path → arrays, as
+    :func:`impactsym.scene.scene_columns`), ``impact.friction`` included; and
+    the per-row reason a row is out of its domain ("" where it is not)."""
+    import numpy as np
+
+    rigid = {path: value for path, value in overrides.items() if path != "impact.friction"}
+    sc = scene_columns(law_scene.scene, rigid)
+    columns = dict(sc.columns)
+    if law_scene.friction is not None:
+        columns["mu_f"] = overrides.get("impact.friction", law_scene.friction)
+    reason = sc.reason
+    if "impact.friction" in overrides:
+        friction = np.asarray(overrides["impact.friction"], dtype=np.float64)
+        reason = np.broadcast_to(reason, friction.shape).copy()
+        reason[(friction < 0) & (reason == "")] = "impact.friction is negative"
+    return columns, reason
