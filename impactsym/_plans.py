@@ -38,6 +38,7 @@ __all__ = [
 BLOCK = 1 << 16
 #: Scene-file names accepted in place of kernel inputs.
 ALIASES = {"normal_angle": "gamma", "restitution": "e", "impulse_ratio": "mu", "moment_restitution": "e_m"}
+ALIASES["friction"] = "mu_f"  # the impact laws (impactsym.laws)
 #: Distributions of `sample`: kind -> names of its parameters.
 DISTRIBUTIONS = {
     "uniform": ("low", "high"),

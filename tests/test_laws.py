@@ -422,6 +422,8 @@ def test_solve_batch_sweep_and_sample_take_the_laws(realistic):
     single = impactsym.solve(dict(SCENE, impact=dict(SCENE["impact"], friction=0.5, restitution=0.4)))
     row = frame[(frame["mu_f"] == 0.5) & (frame["restitution"] == 0.4)].iloc[0]
     assert row["TL"] == single.TL
+    by_name = impactsym.sweep(SCENE, friction=[0.0, 0.5], restitution=0.4)  # scene-file name
+    assert list(by_name["TL"]) == list(frame["TL"][frame["restitution"] == 0.4])
     drawn = impactsym.sample(SCENE, {"mu_f": ("uniform", 0.0, 1.5)}, 300, seed=3)
     assert (drawn["status"] == 0).all() and set(drawn["slip_class"]) <= {0, 1, 2}
 
