@@ -103,3 +103,9 @@ def test_bad_rows_get_a_status_and_leave_the_others():
     assert np.all(out["status"][[0, 1, 2, 4, 6, 8]] == 0)
     with pytest.raises(ValueError, match="mu_f"):
         laws.coulomb_batch({k: v for k, v in c.items() if k != "mu_f"}, "newton")
+    with pytest.raises(ValueError, match="'mu' is not read.*mu_f"):
+        laws.coulomb_batch(dict(c, mu=0.3), "newton")
+    with pytest.raises(ValueError, match="unknown column 'm_1'"):
+        laws.kudlich_slibar_batch(dict(c, m_1=1.0), "full")
+    with pytest.raises(ValueError, match="'e' must be numbers"):
+        laws.coulomb_batch(dict(c, e=np.array(["0.3"] * len(c["e"]))), "newton")

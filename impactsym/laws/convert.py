@@ -25,7 +25,7 @@ SAME = 1e-9
 def ks_to_pim(columns, contact: str = "full") -> dict:
     """Brach's (e, μ) (e_m = 1) that give each row's K–S impulse: ``e``, ``mu``,
     with the K–S ``Pn``, ``Pt`` and ``status``."""
-    out = run_batch("kudlich_slibar", contact, columns)
+    out = run_batch("kudlich_slibar", contact, {k: v for k, v in columns.items() if k not in ("mu", "e_m")})
     return {
         "e": np.asarray(columns["e"], dtype=float) + 0 * out["Pn"],
         "mu": out["mu"],

@@ -89,11 +89,51 @@ def solve_one(model: str, law: str, values: Mapping[str, float]) -> dict:
     return _finish(out)
 
 
+#: Columns a law batch rejects by name, with the reason (silently ignoring them would
+#: hide a mistake: `mu` is not the friction).
+_NOT_READ = {
+    "mu": "the laws set the impulse ratio; the friction coefficient is the column mu_f",
+    "e_m": "a point impulse (M = 0): moment restitution is not used",
+}
+#: Every column some law reads (mu_f is accepted, and ignored, by the full contact).
+_KNOWN = [
+    "m1",
+    "m2",
+    "I1",
+    "I2",
+    "v1x",
+    "v1y",
+    "w1",
+    "v2x",
+    "v2y",
+    "w2",
+    "r1x",
+    "r1y",
+    "r2x",
+    "r2y",
+    "gamma",
+    "e",
+    "mu_f",
+]
+
+
+def _check_names(columns: Mapping) -> None:
+    """ValueError (one line, naming the column) for a column no law reads."""
+    for key in columns:
+        if key in _NOT_READ:
+            raise ValueError(f"columns: {key!r} is not read by the impact laws ({_NOT_READ[key]})")
+        if key not in _KNOWN:
+            raise ValueError(f"columns: unknown column {key!r} (the laws read {' '.join(_KNOWN)})")
+
+
 def _column(columns: Mapping, key: str):
     """One input column as a float64 array (a scalar is broadcast later)."""
     if key not in columns:
         raise ValueError(f"columns: missing input column {key!r}")
-    value = np.asarray(columns[key], dtype=np.float64)
+    raw = np.asarray(columns[key])
+    if raw.dtype.kind not in "fiu":
+        raise ValueError(f"columns: {key!r} must be numbers, got {raw.dtype} values")
+    value = raw.astype(np.float64, copy=False)
     if value.ndim > 1:
         raise ValueError(f"columns: {key!r} must be a 1-D array or a scalar")
     return value
@@ -103,6 +143,7 @@ def run_batch(model: str, law: str, columns: Mapping) -> dict:
     """Every row of `columns` through the law's kernel. Equal-length arrays or
     scalars; returns a dict of arrays (outputs, `status`, `flags`)."""
     module, name = _entry(model, law)
+    _check_names(columns)
     names = columns_of(model, law)
     values = {key: _column(columns, key) for key in names}
     lengths = {v.shape[0] for v in values.values() if v.ndim == 1}

@@ -154,7 +154,7 @@ def law_columns(law_scene: LawScene, overrides: Mapping[str, Any]) -> tuple[dict
 
     rigid = {path: value for path, value in overrides.items() if path != "impact.friction"}
     sc = scene_columns(law_scene.scene, rigid)
-    columns = dict(sc.columns)
+    columns = {k: v for k, v in sc.columns.items() if k not in ("mu", "e_m")}
     if law_scene.friction is not None:
         columns["mu_f"] = overrides.get("impact.friction", law_scene.friction)
     reason = sc.reason
