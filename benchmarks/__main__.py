@@ -20,6 +20,7 @@ SUBCOMMANDS = {
     "uncertainty": "benchmarks.uncertainty",
     "trig": "benchmarks.trig",
     "runout": "benchmarks.runout",
+    "laws": "benchmarks.laws",
 }
 
 

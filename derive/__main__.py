@@ -43,6 +43,8 @@ MODEL_MODULES = (
     "report",
     "jacobian",
     "evidence",
+    "kudlich_slibar",
+    "coulomb",
 )
 # Proved before emission but emitting no module of their own (emit inlines their source).
 PROOF_ONLY_MODULES = ("trig",)

@@ -28,6 +28,9 @@ status meaning
        negative depth)
 12     CRASH3: the PDOF is 90° or more from the inward normal of the damaged
        face (the force would pull the face out)
+13     impact laws: a sliding contact whose compression never ends (the
+       normal relative velocity does not reach zero while sliding)
+14     impact laws: the friction coefficient is negative
 ====== ======================================================================
 
 ====== ======================================================================
@@ -90,6 +93,9 @@ STATUS_MESSAGES = {
     "the width > 0, every depth >= 0",
     _codes.STATUS_PDOF_BEYOND_LIMIT: "the PDOF is 90 degrees or more from the inward normal of "
     "the damaged face: the force would pull the face out",
+    _codes.STATUS_NO_END_OF_COMPRESSION: "the sliding contact's compression never ends: with this "
+    "friction the normal relative velocity at the impact centre does not reach zero while sliding",
+    _codes.STATUS_BAD_FRICTION: "the friction coefficient at the impact centre is negative",
 }
 
 FLAG_MESSAGES = {

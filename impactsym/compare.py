@@ -35,9 +35,10 @@ from . import _kernels
 from ._kernels import PRESETS
 from ._util import require
 from .crash3 import crash3
+from .laws.compare import comparison_input
 from .residue import drop_residue, quantity_scales
 from .result import UNIT_LABELS, Result
-from .scene import Scene, SceneError, load_scene, scene_data, uses_yaw
+from .scene import Scene, SceneError, load_scene, uses_yaw
 from .scene.fields import as_mapping
 from .single import solve
 
@@ -266,7 +267,7 @@ def compare(scene: Scene | Mapping | str | Path) -> Comparison:
     docstring); a crush-only scene gives the CRASH3 row alone. Raises
     :class:`SceneError` when the scene is neither a valid forward scene nor a
     CRASH3 scene, or no model can solve it."""
-    data = scene_data(scene)
+    data, law_rows = comparison_input(scene)  # impactsym.laws: law scenes, and K-S rows
     try:
         base = _base_scene(data)
     except SceneError as exc:
@@ -283,6 +284,7 @@ def compare(scene: Scene | Mapping | str | Path) -> Comparison:
             )
         except SceneError as exc:
             skipped[name] = str(exc)
+    rows += [_law_row(name, text, result, initial) for name, text, result in law_rows]
     if not rows:
         raise SceneError(
             "no model can solve this scene: " + "; ".join(f"{n}: {r}" for n, r in skipped.items())
@@ -385,6 +387,19 @@ def _model_row(data: Mapping, model: str, initial: float) -> ModelRow:
         result.mu,
         result.mu_c,
         [w for w in result.warnings if w not in scene.warnings],
+    )
+
+
+def _law_row(name: str, assumptions: str, result: Result, initial: float) -> ModelRow:
+    """An impact law's row (impactsym.laws): a point impulse, no moment part."""
+    vehicles = tuple(
+        _vehicle_row(v.velocity, v.yaw_rate, v.delta_v, v.delta_v_magnitude) for v in result.vehicles
+    )
+    energy = {"total": result.TL, "normal": result.TLn, "tangential": result.TLt, "moment": None}
+    extra = [f"slip {result.slip}"] if getattr(result, "slip", None) else []
+    warnings = extra + [w for w in result.warnings if "not used" not in w]
+    return ModelRow(
+        name, assumptions, vehicles, energy, _percent(energy, initial), result.mu, result.mu_c, warnings
     )
 
 

@@ -6,7 +6,7 @@ import math
 from collections.abc import Mapping
 from pathlib import Path
 
-from . import _kernels
+from . import _kernels, laws
 from ._kernels import STATUS_NOT_APPROACHING, STATUS_OVERFLOW
 from .codes import describe_status
 from .result import Result
@@ -31,6 +31,8 @@ def solve(scene: Scene | Mapping | str | Path) -> Result:
     for an invalid scene or one the kernel cannot solve (not approaching,
     singular), and :class:`OSError` for a file that cannot be read.
     """
+    if laws.is_law_scene(scene):  # "kudlich_slibar" or "coulomb": impactsym.laws
+        return laws.solve_law(scene)
     scene = load_scene(scene)
     model, critical, values = scene.to_inputs()
     out = _kernels.solve_one(model, critical, values)

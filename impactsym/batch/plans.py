@@ -19,6 +19,7 @@ import numpy as np
 
 from .. import _kernels
 from .._util import require
+from ..laws.scene import is_law_scene, load_law_scene
 from ..scene import CRITICAL, load_scene, show_value
 from .resources import check_axis
 from .solve import solve_batch
@@ -38,6 +39,7 @@ __all__ = [
 BLOCK = 1 << 16
 #: Scene-file names accepted in place of kernel inputs.
 ALIASES = {"normal_angle": "gamma", "restitution": "e", "impulse_ratio": "mu", "moment_restitution": "e_m"}
+ALIASES["friction"] = "mu_f"  # the impact laws (impactsym.laws)
 #: Distributions of `sample`: kind -> names of its parameters.
 DISTRIBUTIONS = {
     "uniform": ("low", "high"),
@@ -63,6 +65,9 @@ class _Base:
 
     @classmethod
     def load(cls, scene) -> _Base:
+        if is_law_scene(scene):  # impactsym.laws: model "coulomb:energetic" etc., nothing fixed
+            law = load_law_scene(scene)
+            return cls(f"{law.model}:{law.law}", law.scene.units, law.inputs(), {})
         scene = load_scene(scene)
         _, critical, values = scene.to_inputs()
         _, fixed = _kernels.preset(scene.model)

@@ -26,6 +26,7 @@ import numpy as np
 
 from .. import _kernels
 from .._util import CHUNK_SIZE, is_dataframe, row_count, spans
+from ..laws.dispatch import check_names, extra_outputs, integer_extras, is_law_model, law_kernel
 from ..scene import CRITICAL
 from .columns import as_column, check_columns, require_mapping
 from .dask_engine import map_chunks
@@ -114,6 +115,8 @@ def solve_batch(columns, model="rigid", outputs=None, engine: str = "local"):
     """
     names, tier = _kernels.requested_outputs(outputs)
     require_mapping(columns)
+    if is_law_model(model):  # "kudlich_slibar[:contact]", "coulomb[:law]": impactsym.laws
+        return _like(columns, _solve_law(columns, model, names))
     if engine == "dask":
         return solve_batch_dask(columns, model=model, outputs=outputs)
     if engine != "local":
@@ -190,6 +193,14 @@ def _solve_group(columns, model: str, critical: bool, names, tier: str, mixed: b
     if plan.fixed:
         columns = _with_fixed(columns, plan.fixed, model, mixed)
     return _run(plan.kernel, columns, names, plan.placeholders)
+
+
+def _solve_law(columns, model: str, names) -> dict:
+    """Rows of an impact law (impactsym.laws): its registry kernel, run as a
+    forward group is, with the law's extra output (``sliding``, ``slip_class``)."""
+    ks = law_kernel(model)
+    check_names(columns)
+    return integer_extras(ks, _run(ks, columns, names + extra_outputs(ks), ()))
 
 
 def _is_critical(mu) -> bool:

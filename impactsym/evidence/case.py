@@ -46,6 +46,8 @@ from .edr_item import edr_observations
 from .items import EVIDENCE_KEYS, Observation, crush_energies, read_item
 
 STATE = ("v1x", "v1y", "w1", "v2x", "v2y", "w2", "Px", "Py", "M")
+#: Impact laws a fit can read its answer in, besides Brach's (e, mu): impactsym.laws.
+FIT_LAWS = ("kudlich_slibar",)
 
 
 @dataclass
@@ -66,6 +68,7 @@ class FitCase:
     headings: tuple[float, float]
     warnings: list[str] = field(default_factory=list)
     normal: tuple | None = None  # the normal angle's distribution: (kind, params [deg], offset [deg])
+    law: str | None = None  # "model": "kudlich_slibar": the fit is also read as that law (FIT_LAWS)
 
 
 def read_case(source: Mapping | str | Path) -> FitCase:
@@ -77,8 +80,13 @@ def read_case(source: Mapping | str | Path) -> FitCase:
     units = data.get("units")
     if units not in ("SI", "US"):
         raise SceneError(f'must be "SI" or "US", got {show_value(units)}', "units")
-    if data.get("model", "rigid") not in ("rigid", "brach"):
-        raise SceneError("fit uses the rigid model (point impulse at the impact centre)", "model")
+    model = data.get("model", "rigid")
+    if model not in ("rigid", "brach", *FIT_LAWS):
+        raise SceneError(
+            "fit uses the rigid model (point impulse at the impact centre), or reads it as the "
+            f"alternative law {' or '.join(FIT_LAWS)}; got {show_value(model)}",
+            "model",
+        )
     leaves = LeafReader(units)
     vehicles = data.get("vehicles")
     if not isinstance(vehicles, list) or len(vehicles) != 2:
@@ -159,6 +167,7 @@ def read_case(source: Mapping | str | Path) -> FitCase:
         headings,
         warnings,
         normal,
+        model if model in FIT_LAWS else None,
     )
 
 

@@ -22,6 +22,7 @@ import numpy as np
 from ..codes import describe_flags, describe_status
 from ..result import json_number
 from .case import STATE, FitCase, read_case
+from .law import law_reading
 from .model import Model, energy_loss
 from .solve import Z90, Identifiability, fit_case
 
@@ -113,6 +114,7 @@ class FitResult:
     flags: int
     info: dict
     warnings: list[str] = field(default_factory=list)
+    law: dict | None = None  # the fit read as an alternative impact law (evidence/law.py)
     kind = "fit"
 
     def value(self, path: str):
@@ -190,7 +192,7 @@ class FitResult:
             },
             "method": self.info,
             "warnings": list(self.warnings),
-        }
+        } | ({"law": self.law} if self.law is not None else {})
 
     def table(self) -> str:
         from .report import table
@@ -241,6 +243,7 @@ def fit(scene: Mapping | str | Path, draws: int = 400, seed: int = 0, method: st
         flags=flags,
         info=info | {"draws": len(samples)},
         warnings=warnings,
+        law=law_reading(case, model.state(x_hat), derived, estimates),
     )
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from ..result import UNIT_LABELS, table_cell
+from .law import law_line
 
 
 def table(result) -> str:
@@ -36,6 +37,8 @@ def table(result) -> str:
             f"{r['evidence']:<10}{r['label']:<38}{table_cell(r['value']):>14}{table_cell(r['fitted']):>14}"
             f"{_z(r['z']):>9}"
         )
+    if result.law is not None:
+        lines += ["", law_line(result.law)]
     lines += (
         ["", "warnings:"] + [f"  - {w}" for w in result.warnings]
         if result.warnings

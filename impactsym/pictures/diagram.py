@@ -468,6 +468,12 @@ def _title(scene: Scene, result: Any) -> str:
         f"{name}: {scene.model} model, {scene.units}; Γ = {impact.normal_angle:g}°, "
         f"e = {impact.restitution:g}, {mu}{em}"
     )
+    if getattr(result, "law", None):  # impactsym.laws: the law, not its rigid reading
+        friction = "" if result.friction is None else f", friction {result.friction:g}"
+        head = (
+            f"{name}: {result.model} ({result.law}{friction}), {scene.units}; "
+            f"Γ = {impact.normal_angle:g}°, e = {impact.restitution:g}"
+        )
     if getattr(result, "kind", None) == "reconstruct":
         head = (
             f"{name}: reconstruction, {scene.units}; Γ = {impact.normal_angle:g}°, implied e = "

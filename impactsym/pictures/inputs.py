@@ -9,6 +9,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from ..laws.scene import is_law_scene, load_law_scene
 from ..scene import Scene, SceneError, load_scene
 from ..scene.reader import read_file
 
@@ -48,6 +49,8 @@ def _resolve(obj: Any, scene: SceneLike | None, result: Any) -> tuple[Scene, Any
     if result is not None and not hasattr(result, "vehicles"):
         raise TypeError(f"plot: expected a result with vehicles, got {type(result).__name__}")
     kind = _SCENE_KINDS.get(str(getattr(result, "kind", "solve")), "forward")
+    if is_law_scene(scene):  # impactsym.laws: drawn as its rigid reading
+        return load_law_scene(scene).scene, result, _impact_position(scene)
     return load_scene(scene, kind=kind), result, _impact_position(scene)
 
 

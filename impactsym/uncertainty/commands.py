@@ -19,6 +19,7 @@ import numpy as np
 from .. import _kernels
 from ..batch import solve_batch
 from ..inverse import invert_batch
+from ..laws.dispatch import is_law_model
 from ..reconstruct import reconstruct_batch
 
 __all__ = ["Command", "RECONSTRUCT", "command_for", "COMMANDS", "COMPLEX_STEP"]
@@ -337,6 +338,13 @@ def command_for(
         from ..crash3 import Crash3Options
 
         return _crash3_command(units, Crash3Options(restitution, energy, correction))
+    if command == "solve" and is_law_model(model):  # impactsym.laws: no Jacobian kernel (no sd_linear)
+        return Command(
+            "solve",
+            lambda c: _split(solve_batch(c, model=model)),
+            lambda c: (None, {}),
+            lambda c, o: _forward_outputs(c, o, True),
+        )
     if command == "solve":
         return _forward_command(model)
     if command == "invert":

@@ -460,6 +460,7 @@ def scene_source(
     """The Source of a scene (path, mapping or Scene) for a command; for
     crash3 with the scene's CRASH3 options overridden by those given."""
     from ..crash3 import crash3_options
+    from ..laws.scene import is_law_scene, law_columns, load_law_scene
     from ..scene import load_scene, scene_columns, scene_data
 
     kind = {"solve": "forward", "invert": "inverse", "reconstruct": "reconstruct", "crash3": "crash3"}.get(
@@ -471,15 +472,23 @@ def scene_source(
     if command == "crash3":
         opts = crash3_options(scene_data(scene), restitution, energy, correction)
         options = {"restitution": opts.restitution, "energy": opts.energy, "correction": opts.correction}
-    parsed = load_scene(scene, kind=kind)
-    inputs = tuple(Input(path, kind_, tuple(params)) for path, kind_, params in parsed.uncertain)
+    model, law = None, None
+    if command == "solve" and is_law_scene(scene):  # impactsym.laws: its rigid reading + the law
+        law = load_law_scene(scene)
+        parsed, model = law.scene, f"{law.model}:{law.law}"
+    else:
+        parsed = load_scene(scene, kind=kind)
+    uncertain = parsed.uncertain if law is None else law.uncertain
+    inputs = tuple(Input(path, kind_, tuple(params)) for path, kind_, params in uncertain)
 
     def columns(overrides):
-        sc = scene_columns(parsed, overrides)
-        return sc.columns, sc.reason
+        if law is None:
+            sc = scene_columns(parsed, overrides)
+            return sc.columns, sc.reason
+        return law_columns(law, overrides)
 
     return Source(
-        command_for(command, parsed.model, parsed.units, **options),
+        command_for(command, model or parsed.model, parsed.units, **options),
         inputs,
         columns,
         tuple(getattr(parsed, "correlations", ())),

@@ -1,0 +1,162 @@
+"""Batch kernels of the impact laws against the memory ceiling and Brach's rigid kernel.
+
+``python -m benchmarks laws [--n 200000] [--repeat 7] [--first-use]``
+
+Rows: ``impactsym.testing.laws.realistic`` (approaching passenger-car scenes with
+friction 0-1.2). Timed interleaved, the order rotating each repeat: the memory
+ceiling of each call (``benchmarks.performance.ceiling_call``: a trivial ``prange``
+kernel reading the same input arrays and writing as many outputs), Brach's rigid
+kernel (``impactsym.solve_batch(model="rigid")`` at e_m = 1 and mu = the friction
+with the sign opposing the slip), and every law through ``impactsym.solve_batch``.
+Reported per call: ns/row (median), ceiling time / call time (median of the per-repeat
+ratios) and call time / rigid time; then the bodies on one thread (each kernel's driver
+through the door's runner with numba at one thread, least of 7) against Brach's
+point-impulse kernel ``rigid_em1``. ``--first-use``: the first ``solve_batch`` of a law
+(200,000 rows) in a fresh process with an empty numba cache: wall and CPU seconds.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+DESCRIPTION = "impact-law batch kernels against the memory ceiling and the rigid kernel"
+LAWS = ("kudlich_slibar", "kudlich_slibar:sliding", "coulomb", "coulomb:poisson", "coulomb:energetic")
+N_OUT = 20  # outputs a law call returns (17 of solve_batch, status, flags, its class)
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("--n", type=int, default=200_000)
+    parser.add_argument("--repeat", type=int, default=7)
+    parser.add_argument("--first-use", action="store_true")
+
+
+def _rows(n: int) -> dict:
+    from impactsym.testing import laws
+
+    c = laws.realistic(int(n * 1.3) + 100, 2026)
+    return {k: np.ascontiguousarray(v[:n]) for k, v in c.items()}
+
+
+def main(args) -> int:
+    import impactsym
+
+    from .performance import ceiling_call
+
+    c = _rows(args.n)
+    n = len(c["e"])
+    rigid = {k: v for k, v in c.items() if k != "mu_f"}
+    gt_sign = np.sign(impactsym.laws.coulomb_batch({k: v[:n] for k, v in c.items()}, "newton")["Pt"])
+    rigid.update(mu=np.ascontiguousarray(gt_sign * c["mu_f"]), e_m=np.ones(n))
+    calls = {"rigid (Brach)": lambda: impactsym.solve_batch(rigid, model="rigid")}
+    ceilings = {"rigid (Brach)": ceiling_call(rigid, 19)}
+    for law in LAWS:
+        cols = c if law != "kudlich_slibar" else {k: v for k, v in c.items() if k != "mu_f"}
+        calls[law] = lambda cols=cols, law=law: impactsym.solve_batch(cols, model=law)
+        ceilings[law] = ceiling_call(cols, N_OUT)
+    for fn in list(calls.values()) + list(ceilings.values()):
+        fn()  # compile / warm
+    times = {name: [] for name in calls}
+    ceil = {name: [] for name in calls}
+    names = list(calls)
+    for r in range(args.repeat):
+        for name in names[r % len(names) :] + names[: r % len(names)]:
+            t0 = time.perf_counter()
+            ceilings[name]()
+            t1 = time.perf_counter()
+            calls[name]()
+            t2 = time.perf_counter()
+            ceil[name].append(t1 - t0)
+            times[name].append(t2 - t1)
+    base = statistics.median(times["rigid (Brach)"])
+    print(f"rows {n}, repeats {args.repeat}, cpus {os.cpu_count()} (shared machine)")
+    print(f"{'call':<26}{'ns/row':>10}{'ceiling/call':>14}{'call/rigid':>12}")
+    report = {}
+    for name in names:
+        t = statistics.median(times[name])
+        ratio = statistics.median(a / b for a, b in zip(ceil[name], times[name]))
+        report[name] = {"ns_per_row": 1e9 * t / n, "ceiling_over_call": ratio, "over_rigid": t / base}
+        print(f"{name:<26}{1e9 * t / n:>10.1f}{ratio:>14.2f}{t / base:>12.2f}")
+    report["serial_ns_per_row"] = _serial(c)
+    if args.first_use:
+        report["first_use_s"] = _first_use()
+    print(json.dumps(report, indent=1))
+    return 0
+
+
+def _serial(c: dict) -> dict:
+    """The kernels' bodies on one thread: each law's driver (the registry's kernel,
+    through the door's runner, numba set to one thread), least of 7, against
+    Brach's point-impulse kernel (rigid_em1)."""
+    import numba
+
+    from impactsym import _kernels
+    from impactsym._kernels import registry
+    from impactsym.laws._door import LAWS, kernel
+
+    n = len(c["e"])
+
+    def least(run):
+        run()
+        times = []
+        for _ in range(7):
+            t0 = time.perf_counter()
+            run()
+            times.append(time.perf_counter() - t0)
+        return 1e9 * min(times) / n
+
+    def call(ks, cols):
+        inputs = [_kernels.as_input(cols[k]) for k in ks.inputs]
+        return lambda: _kernels.run(ks, inputs, n)
+
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        out = {"rigid_em1": least(call(registry.kernel("rigid_em1"), dict(c, mu=c["mu_f"], e_m=1.0)))}
+        for model, laws in LAWS.items():
+            for law in laws:
+                ks = kernel(model, law)
+                out[ks.name] = least(call(ks, c))
+    finally:
+        numba.set_num_threads(threads)
+    print("one thread (ns/row, x rigid_em1):")
+    for name, value in out.items():
+        print(f"  {name:<20}{value:>8.1f}{value / out['rigid_em1']:>8.2f}")
+    return out
+
+
+def _first_use() -> dict:
+    """The first solve_batch of a law (200,000 rows) in a fresh process with an empty
+    numba cache: wall and CPU seconds of the call (the driver compiles on demand)."""
+    code = (
+        "import time, impactsym; from impactsym.testing import laws; c = laws.realistic(ROWS, 1); "
+        "c = {k: v[:200000] for k, v in c.items()}; "
+        "t, p = time.perf_counter(), time.process_time(); impactsym.solve_batch(c, model=MODEL); "
+        "print(time.perf_counter() - t, time.process_time() - p)"
+    )
+    out = {}
+    for model in ("kudlich_slibar:sliding", "coulomb:energetic"):
+        with tempfile.TemporaryDirectory() as cache:
+            env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+            proc = subprocess.run(
+                [sys.executable, "-c", code.replace("MODEL", repr(model)).replace("ROWS", "270000")],
+                capture_output=True,
+                text=True,
+                env=env,
+                timeout=600,
+            )
+        key = f"{model}, 200000 rows"
+        if proc.returncode == 0:
+            wall, cpu = map(float, proc.stdout.strip().splitlines()[-1].split())
+            out[key] = {"wall_s": wall, "cpu_s": cpu, "load": os.getloadavg()[0]}
+        else:
+            out[key] = proc.stderr
+        print(f"first use {key}: {out[key]}")
+    return out
