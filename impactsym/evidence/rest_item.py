@@ -20,6 +20,7 @@ nonlinearity over the rest pose's spread is not propagated (nor is friction).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 
@@ -27,6 +28,7 @@ import numpy as np
 
 from ..errors import SceneError, show_value
 from ..runout import fit_rest, load_runout
+from ..runout.fit import newton
 from ..runout.interval import separation_sensitivity
 from ..scene.casefile import LeafReader, check_keys
 from .items import Observation, vehicle_index
@@ -34,7 +36,8 @@ from .items import Observation, vehicle_index
 #: A fit vehicle's keys that only a rest item reads (the run-out's chassis and tyres).
 RUNOUT_VEHICLE_KEYS = ("wheelbase", "cg_to_front_axle", "track", "wheels", "separation", "friction")
 POSE_KEYS = ("position", "heading")
-LABELS = ("final_velocity[0]", "final_velocity[1] given [0]", "final_yaw_rate given the velocity")
+NONLINEAR = 0.2  # sd of the separation state: a linearisation departing more is named
+LABELS = ("Vx", "Vy given Vx", "W given Vx, Vy")  # V_kx, V_ky, W_k decorrelated in turn
 
 
 def rest_observations(item: Mapping, k: int, data: Mapping, case_values, warnings: list) -> list[Observation]:
@@ -67,21 +70,25 @@ def rest_observations(item: Mapping, k: int, data: Mapping, case_values, warning
             f"[{alt.velocity[0] / length:.3f}, {alt.velocity[1] / length:.3f}] {_unit(units)}/s, yaw rate "
             f"{alt.yaw_rate:.3f} rad/s (used: the one nearest the run-out's starting estimate)"
         )
-    try:
-        inverse = separation_sensitivity(vehicle, fit)[:, :3]  # d(vx, vy, w)/d(x, y, psi)_rest, SI
-    except (ValueError, np.linalg.LinAlgError):
-        raise SceneError(
-            "the run-out at the fitted separation state has no invertible sensitivity to it", path
-        ) from None
-    to_scene = np.diag([1 / length, 1 / length, 1.0])
-    A = to_scene @ inverse
-    rest_cov = np.diag([(sd[0] * length) ** 2, (sd[1] * length) ** 2, math.radians(sd[2]) ** 2])
-    cov = A @ rest_cov @ A.T
+    sigma = np.array([sd[0] * length, sd[1] * length, math.radians(sd[2])])  # SI, rad
+    spread_si = _spread(vehicle, fit, sigma, path)
+    spread = spread_si / np.array([length, length, 1.0])[:, None]  # scene units
+    cov = spread @ spread.T
     p = np.array([fit.velocity[0] / length, fit.velocity[1] / length, fit.yaw_rate])
     try:
         chol = np.linalg.cholesky((cov + cov.T) / 2)
     except np.linalg.LinAlgError:
-        raise SceneError("the rest pose does not fix the separation state (singular covariance)", path) from None
+        raise SceneError(
+            "the rest pose does not fix the separation state (singular covariance)", path
+        ) from None
+    departure = _nonlinearity(vehicle, fit, sigma, spread_si, chol * np.array([length, length, 1.0])[:, None])
+    if departure > NONLINEAR:
+        warnings.append(
+            f"{path} ({label}): the run-out is not linear over the rest pose's sd (refitted at +-1 sd the "
+            f"separation state is {departure:.2g} sd from the linear prediction): the item's observations "
+            "are linearised at the fitted state, so the intervals it drives are too narrow; the rest "
+            "pose's sd may be too large for it"
+        )
     unit_lower = np.diag(np.diag(chol)) @ np.linalg.inv(chol)  # rows: 1 on the diagonal
     n = i + 1
     outputs = (f"V{n}x", f"V{n}y", f"W{n}")
@@ -95,6 +102,40 @@ def rest_observations(item: Mapping, k: int, data: Mapping, case_values, warning
         )
         for j in range(3)
     ]
+
+
+def _spread(vehicle, fit, sigma, path: str) -> np.ndarray:
+    """3 x 3: column j is the change of the separation state (SI) per sd of
+    rest coordinate j (sigma: SI and rad), J^-1 sigma_j from the exact
+    sensitivities at the fitted state."""
+    try:
+        inverse = separation_sensitivity(vehicle, fit)[:, :3]  # d(vx, vy, w)/d(x, y, psi)_rest, SI
+    except (ValueError, np.linalg.LinAlgError):
+        raise SceneError(
+            "the run-out at the fitted separation state has no invertible sensitivity to it", path
+        ) from None
+    return inverse * sigma
+
+
+def _nonlinearity(vehicle, fit, sigma, spread, chol_si) -> float:
+    """The largest departure, in standard deviations of the separation state
+    (whitened by its Cholesky factor, SI), of the state refitted to the rest
+    pose moved by +-1 sd of each coordinate from the linear prediction
+    p +- J^-1 sigma_j: how far the run-out is from linear over the rest
+    pose's spread (Newton from the fitted state, runout.fit.newton)."""
+    start = (*fit.velocity, fit.yaw_rate)
+    p0 = np.array(start)
+    worst = 0.0
+    for j in range(3):
+        for sign in (1.0, -1.0):
+            rest = list(vehicle.rest)
+            rest[j] += sign * sigma[j]
+            moved = newton(dataclasses.replace(vehicle, rest=tuple(rest)), start)
+            if not moved.converged:
+                return math.inf
+            error = np.array([*moved.velocity, moved.yaw_rate]) - p0 - sign * spread[:, j]
+            worst = max(worst, float(np.linalg.norm(np.linalg.solve(chol_si, error))))
+    return worst
 
 
 def _pose(raw, path: str, leaves: LeafReader, what: str) -> tuple[float, float, float]:
