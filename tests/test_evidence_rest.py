@@ -189,3 +189,25 @@ def test_cli_fit_on_the_rest_example(tmp_path):
     assert low < out["vehicles"][1]["speed"] < high
     assert out["method"]["method"] == "closed form"
     assert picture.stat().st_size > 1000
+
+
+def test_us_units_give_the_si_answer():
+    """The example in feet and slugs: the same speeds and sds in ft/s (the run-out
+    fit's tolerance, 0.1 mm, allows a relative 1e-5)."""
+    ft, slug = 0.3048, 14.59390293720636
+    si = json.loads(EXAMPLE.read_text())
+    us = copy.deepcopy(si) | {"units": "US"}
+    for vehicle in us["vehicles"]:
+        vehicle["mass"] /= slug
+        vehicle["yaw_inertia"] /= slug * ft**2
+        for key in ("wheelbase", "cg_to_front_axle", "track"):
+            vehicle[key] /= ft
+        vehicle["impact_point"] = [c / ft for c in vehicle["impact_point"]]
+    for item in us["evidence"]:
+        if item["quantity"] == "rest":
+            item["value"]["position"] = [c / ft for c in item["value"]["position"]]
+            item["sd"]["position"] /= ft
+    a, b = (fit(scene, draws=0).to_json_dict()["vehicles"] for scene in (si, us))
+    for i in range(2):
+        assert b[i]["speed"] == pytest.approx(a[i]["speed"] / ft, rel=1e-5)
+        assert b[i]["speed_sd"] == pytest.approx(a[i]["speed_sd"] / ft, rel=1e-5)
