@@ -211,3 +211,31 @@ def test_us_units_give_the_si_answer():
     for i in range(2):
         assert b[i]["speed"] == pytest.approx(a[i]["speed"] / ft, rel=1e-5)
         assert b[i]["speed_sd"] == pytest.approx(a[i]["speed_sd"] / ft, rel=1e-5)
+
+
+def test_a_run_out_fit_that_did_not_converge_or_is_not_unique_is_named(monkeypatch):
+    """The wiring of the run-out fit's report into the answer's warnings: the
+    fit of vehicle 1's rest pose marked not converged and given an alternative."""
+    import dataclasses
+
+    from impactsym.evidence import rest_item
+
+    real = rest_item.fit_rest
+
+    def doubtful(vehicle):
+        found = real(vehicle)
+        if vehicle.name != "SUV":
+            return found
+        other = dataclasses.replace(found, velocity=(1.0, 2.0), yaw_rate=3.0)
+        return dataclasses.replace(found, converged=False, alternatives=[other])
+
+    monkeypatch.setattr(rest_item, "fit_rest", doubtful)
+    warnings = fit(EXAMPLE, draws=0).warnings
+    assert any(
+        w.startswith("evidence[2] (vehicles[1].rest): the run-out fit") and "did not converge" in w
+        for w in warnings
+    )
+    assert any(
+        w.startswith("evidence[2] (vehicles[1].rest): another separation state") and "1.000, 2.000" in w
+        for w in warnings
+    )
