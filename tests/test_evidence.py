@@ -217,7 +217,12 @@ def test_energy_loss_and_final_speed_evidence():
         (lambda s: s["evidence"][0].update(vehicle="truck"), "evidence[0].vehicle: unknown vehicle"),
         (lambda s: s["evidence"][0].update(value="12 kg"), "evidence[0].value: needs a speed"),
         (lambda s: s["evidence"][0].update(valeu=1), 'evidence[0].valeu: unknown key; did you mean "value"'),
-        (lambda s: s["evidence"][0].update(quantity="rest"), "needs the run-out"),
+        (
+            lambda s: s["evidence"][0].update(
+                quantity="rest", value={"position": [1, 2], "heading": 3}, sd={"position": 1, "heading": 1}
+            ),
+            "runout: missing (a rest item needs the run-out",
+        ),
         (lambda s: s["vehicles"][1].pop("heading"), "vehicles[1].heading: missing"),
         (lambda s: s.update(evidence=[]), "evidence: must be a non-empty list"),
     ],

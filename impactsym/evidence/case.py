@@ -44,6 +44,7 @@ from ..scene.casefile import (
 )
 from .edr_item import edr_observations
 from .items import EVIDENCE_KEYS, Observation, crush_energies, read_item
+from .rest_item import RUNOUT_VEHICLE_KEYS, rest_observations
 
 STATE = ("v1x", "v1y", "w1", "v2x", "v2y", "w2", "Px", "Py", "M")
 #: Impact laws a fit can read its answer in, besides Brach's (e, mu): impactsym.laws.
@@ -76,7 +77,7 @@ def read_case(source: Mapping | str | Path) -> FitCase:
     data = scene_data(source)
     if not isinstance(data, Mapping):
         raise SceneError(f"a scene must be an object, got {show_value(data)}")
-    check_keys(data, (*TOP_KEYS, "evidence"), "")
+    check_keys(data, (*TOP_KEYS, "evidence", "runout"), "")
     units = data.get("units")
     if units not in ("SI", "US"):
         raise SceneError(f'must be "SI" or "US", got {show_value(units)}', "units")
@@ -143,6 +144,9 @@ def read_case(source: Mapping | str | Path) -> FitCase:
         if isinstance(item, Mapping) and "edr" in item:
             check_keys(item, EVIDENCE_KEYS, f"evidence[{k}]")
             observations += edr_observations(item, k, units, names, fixed, source, warnings)
+        elif isinstance(item, Mapping) and item.get("quantity") == "rest":
+            check_keys(item, EVIDENCE_KEYS, f"evidence[{k}]")
+            observations += rest_observations(item, k, data, (units, names, fixed, params), warnings)
         else:
             observations += read_item(item, k, units, names, fixed)
     observations = crush_energies(observations, fixed)
@@ -182,7 +186,7 @@ def _read_vehicle(entry: Any, index: int, leaves: LeafReader) -> bool:
     path = f"vehicles[{index}]"
     if not isinstance(entry, Mapping):
         raise SceneError(f"must be an object, got {show_value(entry)}", path)
-    check_keys(entry, VEHICLE_KEYS, path)
+    check_keys(entry, (*VEHICLE_KEYS, *RUNOUT_VEHICLE_KEYS, "rest"), path)
     fixed = entry.get("fixed", False)
     if not isinstance(fixed, bool):
         raise SceneError(f"must be true or false, got {show_value(fixed)}", f"{path}.fixed")
@@ -209,7 +213,7 @@ def _read_vehicle(entry: Any, index: int, leaves: LeafReader) -> bool:
         leaves.vector(entry["velocity"], f"{path}.velocity", "speed", "velocity")
     if "impact_point" in entry:
         leaves.vector(entry["impact_point"], f"{path}.impact_point", "length", "impact_point")
-    for key in ("final_velocity", "final_yaw_rate", "crush", "length", "width"):
+    for key in ("final_velocity", "final_yaw_rate", "crush", "length", "width", "rest"):
         if key in entry:
             raise SceneError("not read by fit: give it as an evidence item with its sd", f"{path}.{key}")
     return fixed

@@ -2,7 +2,8 @@
 
 Each item becomes one or two scalar :class:`Observation` records (value and sd
 in scene units, angles in radians) and says how the observation model computes
-it. An ``edr`` item is read by :mod:`.edr_item` (through :func:`.case.read_case`).
+it. An ``edr`` item is read by :mod:`.edr_item`, a ``rest`` item by
+:mod:`.rest_item` (both through :func:`.case.read_case`).
 """
 
 from __future__ import annotations
@@ -41,7 +42,9 @@ class Observation:
     computes it (`one_sided` ±1: the truth is at least `value` in that
     sense, a delta-V recorded before its pulse ended): ``("linear", output, (a, b))`` (an output of evidence_linear
     with that vehicle's module at (a, b)), ``("state", name)``,
-    ``("norm" | "direction", (x_output, y_output))``, ``("energy",)``."""
+    ``("norm" | "direction", (x_output, y_output))``, ``("energy",)``,
+    ``("combination", ((c, output), ...))`` (the sum of c times each
+    evidence_linear output: a whitened rest item, rest_item.py)."""
 
     evidence: int
     label: str
@@ -113,11 +116,6 @@ def read_item(item: Any, k: int, units: str, names, fixed) -> list[Observation]:
             f"unknown quantity {show_value(quantity)} (known: {', '.join(QUANTITIES)})", f"{path}.quantity"
         )
     dimension, per_vehicle = QUANTITIES[quantity]
-    if quantity == "rest":
-        raise SceneError(
-            "a rest pose as evidence needs the run-out, which this build does not have yet",
-            f"{path}.quantity",
-        )
     i = vehicle_index(item.get("vehicle"), names, f"{path}.vehicle") if per_vehicle else None
     if per_vehicle and fixed[i]:
         raise SceneError("vehicle is fixed: it has no motion to observe", f"{path}.vehicle")

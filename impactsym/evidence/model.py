@@ -37,6 +37,9 @@ class Model:
         for obs in case.observations:
             if obs.how[0] == "linear":
                 a, b = self.affine(obs.how[1], obs.how[2])
+            elif obs.how[0] == "combination":  # whitened correlated observations (rest_item.py)
+                parts = [(c, self.affine(name)) for c, name in obs.how[1]]
+                a, b = sum(c * ab[0] for c, ab in parts), sum(c * ab[1] for c, ab in parts)
             elif obs.how[0] == "state":
                 a, b = 0.0, np.eye(9)[STATE.index(obs.how[1])]
             else:
