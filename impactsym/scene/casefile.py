@@ -33,7 +33,6 @@ g_n = 9.80665 m/s² (:data:`impactsym.scene.units.STANDARD_GRAVITY`).
 from __future__ import annotations
 
 import difflib
-import math
 import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -42,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import SceneError, show_value
+from .fields import finite_float
 from .units import GRAVITY, to_scene_units
 
 __all__ = [
@@ -227,13 +227,9 @@ class LeafReader:
                 return to_scene_units(value, path, dimension, self.units)
             except ValueError as exc:
                 raise SceneError(str(exc), path) from None
-        if isinstance(value, numbers.Real) and not isinstance(value, bool):
-            try:
-                number = float(value)
-            except OverflowError:
-                number = math.inf
-            if math.isfinite(number):
-                return number
+        number = finite_float(value)
+        if number is not None:
+            return number
         word = DOMAINS[domain][0]
         raise SceneError(
             f"must be a {word}finite number (or a number with a unit, or a "

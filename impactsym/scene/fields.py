@@ -54,16 +54,25 @@ def as_name(value: Any, path: str) -> str:
     return value
 
 
-def as_number(value: Any, path: str) -> float:
-    """``value`` as a finite float (a bare number; for tables other modules read)."""
+def finite_float(value: Any) -> float | None:
+    """``value`` as a finite float when it is a bare real number (not a bool),
+    else None (an integer too large for a float counts as infinite)."""
     if isinstance(value, numbers.Real) and not isinstance(value, bool):
         try:
             number = float(value)
         except OverflowError:
-            number = math.inf
+            return None
         if math.isfinite(number):
             return number
-    raise SceneError(f"must be a finite number, got {show_value(value)}", path)
+    return None
+
+
+def as_number(value: Any, path: str) -> float:
+    """``value`` as a finite float (a bare number; for tables other modules read)."""
+    number = finite_float(value)
+    if number is None:
+        raise SceneError(f"must be a finite number, got {show_value(value)}", path)
+    return number
 
 
 def as_positive(value: Any, path: str) -> float:
