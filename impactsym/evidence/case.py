@@ -42,6 +42,7 @@ from ..scene.casefile import (
     used_normal_angle,
     vehicle_state,
 )
+from .crush_item import crash3_mode, with_profile_energy
 from .edr_item import edr_observations
 from .items import EVIDENCE_KEYS, Observation, crush_energies, read_item
 from .rest_item import RUNOUT_VEHICLE_KEYS, rest_observations
@@ -148,8 +149,9 @@ def read_case(source: Mapping | str | Path) -> FitCase:
             check_keys(item, EVIDENCE_KEYS, f"evidence[{k}]")
             observations += rest_observations(item, k, data, (units, names, fixed, params), warnings)
         else:
+            item = with_profile_energy(item, k, data, names, fixed, warnings) if isinstance(item, Mapping) else item
             observations += read_item(item, k, units, names, fixed)
-    observations = crush_energies(observations, fixed)
+    observations = crush_energies(observations, fixed, crash3_mode(data))
     yaw_observed = {o.how[1] for o in observations if o.how[0] == "state"}
     for i in range(2):
         if f"w{i + 1}" in yaw_observed and f"vehicles[{i}].yaw_rate" not in values and not fixed[i]:
@@ -213,7 +215,7 @@ def _read_vehicle(entry: Any, index: int, leaves: LeafReader) -> bool:
         leaves.vector(entry["velocity"], f"{path}.velocity", "speed", "velocity")
     if "impact_point" in entry:
         leaves.vector(entry["impact_point"], f"{path}.impact_point", "length", "impact_point")
-    for key in ("final_velocity", "final_yaw_rate", "crush", "length", "width", "rest"):
+    for key in ("final_velocity", "final_yaw_rate", "length", "width", "rest"):
         if key in entry:
             raise SceneError("not read by fit: give it as an evidence item with its sd", f"{path}.{key}")
     return fixed

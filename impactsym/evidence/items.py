@@ -16,7 +16,7 @@ from typing import Any
 from ..errors import SceneError, show_value
 from ..scene.casefile import LeafReader, check_keys
 
-EVIDENCE_KEYS = ("vehicle", "quantity", "value", "sd", "at", "edr", "lateral_positive", "module", "note")
+EVIDENCE_KEYS = ("vehicle", "quantity", "value", "sd", "at", "edr", "lateral_positive", "module", "note", "crush")
 #: quantity -> (dimension of its value, needs a vehicle)
 QUANTITIES = {
     "speed": ("speed", True),
@@ -161,27 +161,39 @@ def read_item(item: Any, k: int, units: str, names, fixed) -> list[Observation]:
     return [Observation(k, label, value, sd, how, angle=dimension == "angle")]
 
 
-def crush_energies(observations: list[Observation], fixed) -> list[Observation]:
+def crush_energies(observations: list[Observation], fixed, mode: str = "dissipated") -> list[Observation]:
     """CRASH3's energy "dissipated" (conventions.md): the crush energies of the
-    vehicles together are the energy loss. Against a fixed barrier one vehicle's
-    is; two moving vehicles need both (their sum, the sds in quadrature)."""
+    vehicles together are the energy loss. Given for every moving vehicle (one
+    against a fixed barrier) their sum is an observation of T_L (the sds in
+    quadrature); given for one of two moving vehicles it is a one-sided bound,
+    T_L at least that energy (the other's crush energy is ≥ 0). `mode` is the
+    scene's ``crash3.energy``: "absorbed" is refused (no derived observation)."""
     crush = [o for o in observations if o.label.endswith(".crush_energy")]
     if not crush:
         return observations
-    moving = [i for i in (0, 1) if not fixed[i]]
-    crushed = sorted({int(o.label[len("vehicles[")]) for o in crush})
-    if len(crush) != len(moving) or crushed != moving:
+    if mode != "dissipated":
         raise SceneError(
-            "crush energies are the energy loss of the impact only together: give one crush_energy per "
-            "moving vehicle (one against a fixed barrier), or energy_loss (crash3 --json energy_total)",
-            f"evidence[{crush[0].evidence}].quantity",
+            'a crush_energy item is read as CRASH3\'s energy "dissipated" only (the energy loss); '
+            '"absorbed" needs a derived observation the fit does not have',
+            "crash3.energy",
         )
+    moving = [i for i in (0, 1) if not fixed[i]]
+    crushed = sorted(int(o.label[len("vehicles[")]) for o in crush)
+    if len(set(crushed)) != len(crushed):
+        raise SceneError(
+            "one crush_energy per vehicle (a vehicle's crush energy is given twice)",
+            f"evidence[{crush[-1].evidence}].vehicle",
+        )
+    both = crushed == moving
     total = Observation(
         crush[0].evidence,
-        "energy_loss.total" if len(crush) == 1 else "energy_loss.total (sum of the crush energies)",
+        ("energy_loss.total" if len(moving) == 1 else "energy_loss.total (sum of the crush energies)")
+        if both
+        else f"energy_loss.total (at least vehicles[{crushed[0]}].crush_energy)",
         sum(o.value for o in crush),
         math.sqrt(sum(o.sd**2 for o in crush)),
         ("energy",),
+        one_sided=0 if both else 1,
     )
     return [o for o in observations if o not in crush] + [total]
 
