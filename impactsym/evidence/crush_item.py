@@ -38,7 +38,8 @@ def profile_energy(item: Mapping, i: int, k: int, data: Mapping, warnings: list)
     where = f"vehicles[{i}].crush" if own else f"evidence[{k}].crush"
     if raw is None:
         raise SceneError(
-            f"missing: give value, or crush (a CRASH3 profile), or vehicles[{i}].crush", f"evidence[{k}].value"
+            f"missing: give value, or crush (a CRASH3 profile), or vehicles[{i}].crush",
+            f"evidence[{k}].value",
         )
     vehicles: list[dict[str, Any]] = [{"fixed": True}, {"fixed": True}]
     vehicles[i] = {"name": "crushed", "mass": 1.0, "crush": raw}  # the energy needs no mass

@@ -16,7 +16,18 @@ from typing import Any
 from ..errors import SceneError, show_value
 from ..scene.casefile import LeafReader, check_keys
 
-EVIDENCE_KEYS = ("vehicle", "quantity", "value", "sd", "at", "edr", "lateral_positive", "module", "note", "crush")
+EVIDENCE_KEYS = (
+    "vehicle",
+    "quantity",
+    "value",
+    "sd",
+    "at",
+    "edr",
+    "lateral_positive",
+    "module",
+    "note",
+    "crush",
+)
 #: quantity -> (dimension of its value, needs a vehicle)
 QUANTITIES = {
     "speed": ("speed", True),
