@@ -149,11 +149,7 @@ def read_case(source: Mapping | str | Path) -> FitCase:
             check_keys(item, EVIDENCE_KEYS, f"evidence[{k}]")
             observations += rest_observations(item, k, data, (units, names, fixed, params), warnings)
         else:
-            item = (
-                with_profile_energy(item, k, data, names, fixed, warnings)
-                if isinstance(item, Mapping)
-                else item
-            )
+            item = with_profile_energy(item, k, data, names, fixed, warnings)
             observations += read_item(item, k, units, names, fixed)
     observations = crush_energies(observations, fixed, crash3_mode(data))
     yaw_observed = {o.how[1] for o in observations if o.how[0] == "state"}

@@ -66,7 +66,11 @@ def with_profile_energy(item: Mapping, k: int, data: Mapping, names, fixed, warn
     """Evidence item `k` with a profile (``crush``, or neither ``crush`` nor
     ``value``) as the same item with its CRASH3 energy as ``value``; any other
     item unchanged."""
-    if item.get("quantity") != "crush_energy" or ("value" in item and "crush" not in item):
+    if (
+        not isinstance(item, Mapping)
+        or item.get("quantity") != "crush_energy"
+        or ("value" in item and "crush" not in item)
+    ):
         return item
     if "value" in item:
         raise SceneError("give value or crush, not both", f"evidence[{k}].crush")
