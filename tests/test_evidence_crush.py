@@ -135,3 +135,12 @@ def test_absorbed_energy_and_missing_profile_are_refused():
     with pytest.raises(SceneError) as err:
         fit(scene, draws=0)
     assert err.value.field == "evidence[3].value"
+
+
+def test_an_unused_vehicle_crush_block_is_named_in_the_warnings():
+    t = truth(19)
+    scene, _ = scene_with_crush(t, 0.4, own=True)
+    del scene["evidence"][4]
+    got = fit(scene, draws=0).to_json_dict()
+    assert any(w.startswith("vehicles[1].crush is not used") for w in got["warnings"])
+    assert not any(w.startswith("vehicles[0].crush is not used") for w in got["warnings"])

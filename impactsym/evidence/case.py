@@ -42,7 +42,7 @@ from ..scene.casefile import (
     used_normal_angle,
     vehicle_state,
 )
-from .crush_item import crash3_mode, with_profile_energy
+from .crush_item import crash3_mode, unused_crush, with_profile_energy
 from .edr_item import edr_observations
 from .items import EVIDENCE_KEYS, Observation, crush_energies, read_item
 from .rest_item import RUNOUT_VEHICLE_KEYS, rest_observations
@@ -152,6 +152,7 @@ def read_case(source: Mapping | str | Path) -> FitCase:
             item = with_profile_energy(item, k, data, names, fixed, warnings)
             observations += read_item(item, k, units, names, fixed)
     observations = crush_energies(observations, fixed, crash3_mode(data))
+    warnings += unused_crush(data, names)
     yaw_observed = {o.how[1] for o in observations if o.how[0] == "state"}
     for i in range(2):
         if f"w{i + 1}" in yaw_observed and f"vehicles[{i}].yaw_rate" not in values and not fixed[i]:

@@ -79,3 +79,22 @@ def with_profile_energy(item: Mapping, k: int, data: Mapping, names, fixed, warn
         raise SceneError("vehicle is fixed: it has no motion to observe", f"evidence[{k}].vehicle")
     energy = profile_energy(item, i, k, data, warnings)
     return {**{key: v for key, v in item.items() if key != "crush"}, "value": energy}
+
+
+def unused_crush(data: Mapping, names) -> list[str]:
+    """A warning per vehicle ``crush`` block no evidence item reads (it is
+    evidence only through a ``crush_energy`` item with neither value nor crush)."""
+    used = {
+        vehicle_index(item.get("vehicle"), names, f"evidence[{k}].vehicle")
+        for k, item in enumerate(data["evidence"])
+        if isinstance(item, Mapping)
+        and item.get("quantity") == "crush_energy"
+        and "value" not in item
+        and "crush" not in item
+    }
+    return [
+        f'vehicles[{i}].crush is not used: add {{"vehicle": {i}, "quantity": "crush_energy", "sd": …}} '
+        "to the evidence to observe its crush energy"
+        for i, v in enumerate(data["vehicles"])
+        if isinstance(v, Mapping) and "crush" in v and i not in used
+    ]
