@@ -3,22 +3,14 @@
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
+from tests.helpers import run_cli_subprocess as run
+
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "fit_intersection_us.json"
-ENV = dict(os.environ, PYTHONPATH=str(ROOT))
-
-
-def run(*args):
-    return subprocess.run(
-        [sys.executable, "-m", "impactsym", *args], capture_output=True, text=True, env=ENV, timeout=300
-    )
 
 
 def test_fit_json_has_the_contract_keys():

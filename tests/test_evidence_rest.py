@@ -19,7 +19,7 @@ from impactsym.errors import SceneError
 from impactsym.runout import runout
 
 from .evidence_truth import base_scene, truth
-from .helpers import EXAMPLES, cli_argv, cli_env, one_line_error
+from .helpers import EXAMPLES, one_line_error, run_cli_subprocess
 
 RUNOUT = {"friction": 0.7, "rolling_resistance": 0.015}
 LOCKED = {"wheelbase": 2.7, "cg_to_front_axle": 1.2, "track": 1.55, "wheels": "locked"}
@@ -174,13 +174,8 @@ def test_a_rest_item_without_run_out_data_is_a_cli_error(tmp_path, capsys):
 
 
 def test_cli_fit_on_the_rest_example(tmp_path):
-    import subprocess
-
     picture = tmp_path / "scene.png"
-    proc = subprocess.run(
-        cli_argv("fit", EXAMPLE, "--json", "--scene-plot", picture),
-        capture_output=True, text=True, env=cli_env(), timeout=300,
-    )  # fmt: skip
+    proc = run_cli_subprocess("fit", EXAMPLE, "--json", "--scene-plot", picture)
     assert proc.returncode == 0, proc.stderr
     out = json.loads(proc.stdout)
     assert [r["evidence"] for r in out["residuals"]] == [0, 1, 1, 1, 2, 2, 2]

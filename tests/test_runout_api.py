@@ -5,9 +5,6 @@ from __future__ import annotations
 import copy
 import json
 import math
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -15,6 +12,7 @@ import pytest
 from impactsym.errors import SceneError
 from impactsym.runout import load_runout, runout
 from impactsym.runout.fit import fit_rest
+from tests.helpers import run_cli_subprocess
 
 ROOT = Path(__file__).resolve().parents[1]
 SEDAN = ROOT / "examples" / "runout" / "sedan.json"
@@ -131,14 +129,7 @@ def test_fit_round_trip_recovers_the_separation_state(wheels, velocity, w):
 
 
 def _cli(*args):
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    return subprocess.run(
-        [sys.executable, "-m", "impactsym", "runout", *args],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=300,
-    )
+    return run_cli_subprocess("runout", *args)
 
 
 def test_cli_json_path_and_plot(tmp_path):
@@ -250,36 +241,12 @@ def test_fit_with_a_tyre_mark_direction_at_separation():
 def test_solve_and_reconstruct_commands_chain_through_the_runout():
     """conventions.md, "Chained": a solve scene with run-out data reports each
     vehicle's rest; a reconstruct scene with rest poses fits the run-outs first."""
-    proc = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "impactsym",
-            "solve",
-            str(ROOT / "examples" / "runout" / "chain_solve.json"),
-            "--json",
-        ],
-        capture_output=True,
-        text=True,
-        env=dict(os.environ, PYTHONPATH=str(ROOT)),
-        timeout=300,
-    )
+    proc = run_cli_subprocess("solve", ROOT / "examples" / "runout" / "chain_solve.json", "--json")
     assert proc.returncode == 0, proc.stderr
     solved = json.loads(proc.stdout)
     assert all(set(v["rest"]) == {"position", "heading"} for v in solved["vehicles"])
-    proc = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "impactsym",
-            "reconstruct",
-            str(ROOT / "examples" / "runout" / "chain_reconstruct.json"),
-            "--json",
-        ],
-        capture_output=True,
-        text=True,
-        env=dict(os.environ, PYTHONPATH=str(ROOT)),
-        timeout=300,
+    proc = run_cli_subprocess(
+        "reconstruct", ROOT / "examples" / "runout" / "chain_reconstruct.json", "--json"
     )
     assert proc.returncode == 0, proc.stderr
     speeds = [v["speed"] for v in json.loads(proc.stdout)["vehicles"]]
