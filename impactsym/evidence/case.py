@@ -42,6 +42,7 @@ from ..scene.casefile import (
     used_normal_angle,
     vehicle_state,
 )
+from ..scene.reader import read_body
 from .crush_item import crash3_mode, unused_crush, with_profile_energy
 from .edr_item import edr_observations
 from .items import EVIDENCE_KEYS, Observation, crush_energies, read_item
@@ -201,14 +202,7 @@ def _read_vehicle(entry: Any, index: int, leaves: LeafReader) -> bool:
             raise SceneError(
                 "missing (the pre-impact direction of travel and orientation)", f"{path}.heading"
             )
-    for key, dimension in (
-        ("mass", "mass"),
-        ("weight", "force"),
-        ("yaw_inertia", "inertia"),
-        ("radius_of_gyration", "length"),
-    ):
-        if key in entry:
-            leaves.number(entry[key], f"{path}.{key}", dimension, "positive")
+    read_body(leaves, entry, path)
     for key, dimension in (("yaw_rate", "rate"), ("heading", "angle")):
         if key in entry:
             leaves.number(entry[key], f"{path}.{key}", dimension)

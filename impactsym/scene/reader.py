@@ -360,14 +360,7 @@ def _read_vehicle(data: Mapping, index: int, fixed: bool, reading: _Reading) -> 
             if key not in data and not (key in _ALTERNATIVE and _ALTERNATIVE[key] in data):
                 raise SceneError("missing", f"{path}.{key}")
     leaves = reading.leaves
-    for key, dimension in (
-        ("mass", "mass"),
-        ("weight", "force"),
-        ("yaw_inertia", "inertia"),
-        ("radius_of_gyration", "length"),
-    ):
-        if key in data:
-            leaves.number(data[key], f"{path}.{key}", dimension, "positive")
+    read_body(leaves, data, path)
     for key in ("velocity", "final_velocity"):
         if key in data:
             leaves.vector(data[key], f"{path}.{key}", "speed", "velocity")
@@ -442,3 +435,20 @@ def _units(value: Any) -> str:
     if isinstance(value, str) and value.upper() in UNITS:
         return value.upper()
     return as_choice(value, "units", UNITS, "units")
+
+
+#: A vehicle's body quantities (each with its alternative form) and their dimensions.
+BODY_FIELDS = (
+    ("mass", "mass"),
+    ("weight", "force"),
+    ("yaw_inertia", "inertia"),
+    ("radius_of_gyration", "length"),
+)
+
+
+def read_body(leaves, data, path: str) -> None:
+    """Read the body quantities ``data`` gives (mass or weight, yaw inertia or
+    radius of gyration) as positive leaves at ``path``; SceneError naming the field."""
+    for key, dimension in BODY_FIELDS:
+        if key in data:
+            leaves.number(data[key], f"{path}.{key}", dimension, "positive")
