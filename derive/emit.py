@@ -532,11 +532,12 @@ def driver_name(kernel: Kernel) -> str:
 
 def driver_columns(kernel: Kernel) -> tuple[str, ...]:
     """The driver's input columns: the kernel's arguments, and for a kernel in
-    normal form the angle just before (nx, ny)."""
+    normal form the angle just before (nx, ny) and the one normal of the
+    batch, `normal`, just after."""
     args = [str(s) for s in kernel.inputs]
     if kernel.angle is not None:
         at = args.index("nx")
-        args.insert(at, str(kernel.angle))
+        args[at : at + 2] = [str(kernel.angle), "nx", "ny", "normal"]
     return tuple(args)
 
 
@@ -544,11 +545,16 @@ def driver_function(kernel: Kernel, style: Style = DEFAULT) -> str:
     """The batch driver into caller-owned outputs, one row per index, a
     `prange` loop (a batch of a few rows pays a few microseconds for the
     launch: benchmarks/results/performance.md). A kernel in normal form takes
-    the angle and (nx, ny): one normal for every row as length-1 (nx, ny),
-    read once before the loop (no filled columns to write and read again); or
-    per row, the angle column of the batch's length (`_sincos` per row) or
-    else (nx, ny) columns (angles beyond SINCOS_LIMIT, whose normal the
-    runtime forms with NumPy)."""
+    the angle column (`_sincos` per row), or `normal`, one (nx, ny) for every
+    row as a length-2 array read once before the loop (no filled columns to
+    write and read again), or (nx, ny) columns (angles beyond SINCOS_LIMIT,
+    whose normal the runtime forms with NumPy); the other two are None.
+
+    Why three separate `if ... is not None` and not if/elif: numba prunes a
+    branch on an argument typed None before it types the function, so each
+    compiled signature holds only its own loop and a first use compiles one
+    copy of the body, not three (an `elif` after a test on an array cannot be
+    pruned: numba knows only that a None is None)."""
     args = [str(s) for s in kernel.inputs]
     outs = [f"out_{s}" for s in kernel.output_names()] + ["out_status", "out_flags"]
     ind = "        "
@@ -563,17 +569,17 @@ def driver_function(kernel: Kernel, style: Style = DEFAULT) -> str:
     angle = f"c_{kernel.angle}"
     lines += [
         "    n = out_status.shape[0]",
-        "    if c_nx.shape[0] == 1:",
-        "        nx, ny = c_nx[0], c_ny[0]",
+        f"    if {angle} is not None:",
+        "        for i in prange(n):",
+        f"            ny, nx = _sincos({angle}[i])",
+        *_row(kernel, args, outs, ind + "    ", True),
+        "    if c_normal is not None:",
+        "        nx, ny = c_normal[0], c_normal[1]",
         "        for i in prange(n):",
         *_row(kernel, args, outs, ind + "    ", True),
-        "    else:",
-        f"        angle = {angle}.shape[0] == n",
+        "    if c_nx is not None:",
         "        for i in prange(n):",
-        "            if angle:",
-        f"                ny, nx = _sincos({angle}[i])",
-        "            else:",
-        "                nx, ny = c_nx[i], c_ny[i]",
+        "            nx, ny = c_nx[i], c_ny[i]",
         *_row(kernel, args, outs, ind + "    ", True),
     ]
     return "\n".join(lines) + "\n"

@@ -1,7 +1,7 @@
 """`impactsym compile`: compile (or load from numba's cache) every batch driver.
 
 Nothing compiles in the background: a batch compiles the one driver it needs
-on its first use on a machine (docs/kernels.md gives the time), and this
+(for the form of the normal it gives) on its first use on a machine (docs/kernels.md gives the time), and this
 compiles all of them at once, for a machine that should never wait.
 """
 
@@ -14,16 +14,30 @@ from .registry import batch_kernels
 
 
 def compile_all(progress: Callable[[str], None] | None = None) -> int:
-    """Compile every driver with the one signature the runtime calls it with:
-    float64 C arrays in and out, int32 status and flags. Returns how many."""
-    from numba import types
-
+    """Compile every driver with the signatures the runtime calls it with:
+    float64 C arrays in and out, int32 status and flags, and for a kernel in
+    normal form one signature per form of the normal (the angle, one normal,
+    (nx, ny) columns; the forms not given are None). Returns how many drivers."""
     count = 0
     for ks in batch_kernels():
         start = time.perf_counter()
-        floats = len(ks.driver_columns) + len(ks.outputs)
-        ks.driver.compile((types.float64[::1],) * floats + (types.int32[::1],) * 2)
+        for signature in _signatures(ks):
+            ks.driver.compile(signature)
         count += 1
         if progress is not None:
             progress(f"{ks.name}: {time.perf_counter() - start:.1f} s")
     return count
+
+
+def _signatures(ks) -> list[tuple]:
+    """The driver's signatures: one, or one per form of the normal."""
+    from numba import types
+
+    array, none = types.float64[::1], types.none
+    outs = (array,) * len(ks.outputs) + (types.int32[::1],) * 2
+    columns = [array] * len(ks.driver_columns)
+    if ks.angle is None:
+        return [(*columns, *outs)]
+    at = ks.driver_columns.index(ks.angle)
+    forms = ((array, none, none, none), (none, none, none, array), (none, array, array, none))
+    return [(*columns[:at], *form, *columns[at + 4 :], *outs) for form in forms]

@@ -1,13 +1,14 @@
 """Columns in, outputs out: one kernel over a batch (its numba driver) or one
 scene (its per-scene function).
 
-Every driver argument is a C-contiguous float64 array, so each driver compiles
-once per machine (numba's on-disk cache) whatever mix of scalar and array
-columns a caller gives: a scalar column becomes a filled array, reused chunk
-after chunk (`FILL_BYTES`). An angle column is passed as it is (the driver
-forms the normal per row); one angle for the batch becomes its normal, once,
-as length-1 (nx, ny) that the driver reads before its loop; per-row angles
-beyond SINCOS_LIMIT get NumPy's cos/sin. Every batch runs the driver's
+Every driver argument is a C-contiguous float64 array (or None for the
+normal's forms the batch does not use), so each driver compiles once per
+machine and form of the normal (numba's on-disk cache) whatever mix of scalar
+and array columns a caller gives: a scalar column becomes a filled array,
+reused chunk after chunk (`FILL_BYTES`). An angle column is passed as it is
+(the driver forms the normal per row); one angle for the batch becomes its
+normal, once, as the length-2 `normal` that the driver reads before its loop;
+per-row angles beyond SINCOS_LIMIT get NumPy's cos/sin as (nx, ny) columns. Every batch runs the driver's
 `prange` loop, however small: on one row the launch costs a few microseconds
 more than a serial loop, measured in benchmarks/results/performance.md.
 """
@@ -30,7 +31,6 @@ from .registry import SINCOS_LIMIT, KernelSet
 FILL_BYTES = 16 << 20
 MIN_CHUNK = 1 << 16
 _SCRATCH = threading.local()
-_NONE = np.empty(0)  # an absent column: the angle when the normal is given
 
 
 def as_input(value):
@@ -67,19 +67,21 @@ def run(ks: KernelSet, inputs: list, n: int | None = None) -> tuple[dict, np.nda
 
 def _driver_columns(ks: KernelSet, inputs: list) -> list:
     """The driver's columns in its order (scalars still scalars). For a kernel
-    in normal form: the angle column, or one normal for every row as length-1
-    (nx, ny), or per-row normals from NumPy beyond SINCOS_LIMIT."""
+    in normal form, (angle, nx, ny, normal): the angle column, or one normal
+    for every row as the length-2 `normal`, or per-row normals from NumPy
+    beyond SINCOS_LIMIT; None for the other forms (the driver compiles only
+    the loop of the form it is given: derive/emit.py `driver_function`)."""
     if ks.angle is None:
         return inputs
     at = ks.inputs.index(ks.angle)
     angle = inputs[at]
     if not isinstance(angle, np.ndarray):
-        normal = [_NONE, *(np.array([c]) for c in ks.unit_normal(angle))]
+        normal = [None, None, None, np.array(ks.unit_normal(angle))]
     elif _beyond(angle, SINCOS_LIMIT):
         with np.errstate(invalid="ignore"):
-            normal = [_NONE, np.cos(angle), np.sin(angle)]
+            normal = [None, np.cos(angle), np.sin(angle), None]
     else:
-        normal = [angle, _NONE, _NONE]
+        normal = [angle, None, None, None]
     return inputs[:at] + normal + inputs[at + 1 :]
 
 
@@ -97,10 +99,10 @@ def _call(driver, columns: list, outs: list) -> None:
     """Run `driver` over all rows; scalar columns become filled arrays, a
     chunk of rows at a time."""
     n = outs[-1].shape[0]
-    if all(isinstance(c, np.ndarray) for c in columns):
+    if all(c is None or isinstance(c, np.ndarray) for c in columns):
         driver(*columns, *outs)
         return
-    scalars = sum(not isinstance(c, np.ndarray) for c in columns)
+    scalars = sum(isinstance(c, float) for c in columns)
     size = min(n, max(MIN_CHUNK, FILL_BYTES // (8 * scalars)))
     fills = _fills(columns, size, scalars)
     for start in range(0, n, size):
@@ -112,9 +114,9 @@ def _call(driver, columns: list, outs: list) -> None:
 
 
 def _rows_of(column: np.ndarray, start: int, stop: int, n: int) -> np.ndarray:
-    """Rows start..stop-1 of an array column; a column of another length than
-    the batch (one normal as length-1 arrays, an absent angle) is passed whole."""
-    return column[start:stop] if column.shape[0] == n else column
+    """Rows start..stop-1 of an array column; the one normal (length 2) and
+    an absent form of the normal (None) are passed whole."""
+    return column[start:stop] if column is not None and column.shape[0] == n else column
 
 
 def _fills(columns: list, size: int, scalars: int) -> list:
@@ -125,7 +127,7 @@ def _fills(columns: list, size: int, scalars: int) -> list:
         scratch = _SCRATCH.buffer = np.empty(size * scalars)
     fills, k = [], 0
     for column in columns:
-        if isinstance(column, np.ndarray):
+        if not isinstance(column, float):
             fills.append(None)
             continue
         fill = scratch[k * size : (k + 1) * size]
