@@ -82,10 +82,13 @@ def run_chained(args: argparse.Namespace, command: str) -> int:
     if getattr(args, "plot", None):
         raise SceneError("draw a chained scene's run-outs with impactsym runout SCENE --plot", "--plot")
     from .chain import reconstruct_from_rest, solve_to_rest
+    from .uncertain import nominal_data
 
-    result = without_json_residue(
-        (solve_to_rest if command == "solve" else reconstruct_from_rest)(args.scene)
-    )
+    if command == "solve":
+        result = solve_to_rest(args.scene)
+    else:  # distributions on the run-out's leaves: the nominal scene, as every plain command
+        result = reconstruct_from_rest(nominal_data(args.scene)[0])
+    result = without_json_residue(result)
     print(json.dumps(json_clean(result), indent=2) if args.json else _chain_table(result))
     return 0
 
@@ -94,7 +97,7 @@ def _run_chained_uncertainty(args: argparse.Namespace) -> int:
     """``reconstruct SCENE --uncertainty`` of a scene with rest poses (uncertain.py)."""
     from ..uncertainty.cli import DEFAULT_DRAWS
     from ..uncertainty.result import MIN_INTERVAL_DRAWS
-    from .uncertain import chained_uncertainty
+    from .uncertain import chained_uncertainty, uncertainty_json
 
     if getattr(args, "plot", None):
         raise SceneError("not drawn for a scene with rest poses; leave out --plot", "--plot")
@@ -108,8 +111,7 @@ def _run_chained_uncertainty(args: argparse.Namespace) -> int:
     except (ValueError, ImportError) as exc:  # a one-line reason, exit code 2
         raise SceneError(str(exc)) from None
     if args.json:
-        both = without_json_residue({**chained.result, "uncertainty": u.to_json_dict()})
-        print(json.dumps(json_clean(both), indent=2, allow_nan=False))
+        print(json.dumps(json_clean(uncertainty_json(chained, u)), indent=2, allow_nan=False))
     else:
         print(_chain_table(without_json_residue(chained.result)))
         print()

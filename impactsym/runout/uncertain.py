@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import SceneError
+from ..residue import without_json_residue
 from ..scene import load_scene, scene_columns, scene_data
 from ..scene.casefile import LeafReader, domain_reasons, parse_correlations, vehicle_state
 from ..uncertainty import Source, propagate
@@ -50,11 +51,14 @@ from ..uncertainty import propagation as engine
 from ..uncertainty.commands import RECONSTRUCT, Command
 from ..uncertainty.inputs import Input, correlation_matrix
 from .batch import columns, run_row, runout_batch
-from .chain import _impact_part, reconstruct_from_rest
+from .chain import _check, _impact_part, reconstruct_from_rest
 from .drawfit import NOT_CONVERGED, fit_draws
 from .scene import SLUG, RunoutScene, load_runout, row_values
 
 FD_TOL = 1e-10  # integrator tolerance of the central differences (docs/runout.md: error ~6e-7 m)
+# Integrator tolerance of the nominal sensitivities: at the default 1e-8 they were 2 % off the
+# central differences of forward run-outs for a braked wheel (chain_solve's SUV; 1e-12: 0.05 %).
+SENS_TOL = 1e-12
 FD_STEP = 1e-2  # of the input's sd
 RUNOUT_LEAVES = {
     "friction": ("number", "positive"),
@@ -259,7 +263,7 @@ class Chained:
         other = [i for i, c in enumerate(names) if c not in KNOWN]
         for kv, vehicle in enumerate(self.runout.vehicles):
             p = self.p[kv]
-            y, _, status, _, _ = run_row(row_values(vehicle, names, *p), sens=True)
+            y, _, status, _, _ = run_row(row_values(vehicle, names, *p), tol=SENS_TOL, sens=True)
             if status != 0:
                 raise SceneError("the run-out at the nominal fitted state failed", f"vehicles[{kv}]")
             S = y[7:].reshape(6, 4)
@@ -331,9 +335,12 @@ def _outputs(c: Mapping, o: Mapping) -> dict:
     return out
 
 
-def load_chained(scene) -> Chained:
-    """Read a reconstruct-from-rest scene with distributions; fit and linearise
-    the nominal run-outs. One-line SceneError for a bad scene."""
+def nominal_data(scene) -> tuple[dict, dict, dict]:
+    """(the scene with every leaf the run-out reads a plain number in scene
+    units: its nominal value; the run-out's leaves; the impact part as given,
+    distributions kept) of a reconstruct-from-rest scene. The plain chained
+    ``reconstruct`` solves the first (conventions.md: the plain commands solve
+    the nominal scene)."""
     data = copy.deepcopy(scene_data(scene))
     if not isinstance(data, dict) or data.get("units") not in ("SI", "US"):
         load_runout(data)  # names what is wrong
@@ -348,7 +355,9 @@ def load_chained(scene) -> Chained:
                 "not read by --uncertainty through the run-out (leave it out)",
                 f"vehicles[{i}].separation.mark_directions",
             )
-    impact = _impact_part(data) if isinstance(data.get("vehicles"), list) else data
+    if len(_check(data)) != len(data["vehicles"]):
+        reconstruct_from_rest(data)  # names the vehicle without run-out data
+    impact = _impact_part(data)
     placeholder = load_scene(_with_final(impact, [(0.0, 0.0, 0.0)] * 2), kind="reconstruct")
     nominal = {path: leaf.nominal for path, leaf in placeholder.leaves.items()}
     for i, v in enumerate(data["vehicles"]):
@@ -360,6 +369,13 @@ def load_chained(scene) -> Chained:
         )
         if state["heading"] is not None:
             v["heading"] = float(state["heading"])
+    return data, leaves, impact
+
+
+def load_chained(scene) -> Chained:
+    """Read a reconstruct-from-rest scene with distributions; fit and linearise
+    the nominal run-outs. One-line SceneError for a bad scene."""
+    data, leaves, impact = nominal_data(scene)
     result = reconstruct_from_rest(data)
     finals = [
         (*e["runout"]["separation"]["velocity"], e["runout"]["separation"]["yaw_rate"])
@@ -410,5 +426,9 @@ def chained_uncertainty(scene, draws: int = 10_000, seed: int | None = None, sob
 def reconstruct_uncertainty(scene, draws: int = 10_000, seed: int | None = None, sobol: bool = False) -> dict:
     """``impactsym reconstruct SCENE --uncertainty --json`` of a scene with rest
     poses: the chained reconstruction's JSON plus ``"uncertainty"``."""
-    chained, u = chained_uncertainty(scene, draws, seed, sobol)
-    return {**chained.result, "uncertainty": u.to_json_dict()}
+    return uncertainty_json(*chained_uncertainty(scene, draws, seed, sobol))
+
+
+def uncertainty_json(chained: Chained, u) -> dict:
+    """The chained reconstruction's JSON with ``"uncertainty"`` (rounding residue shown as 0)."""
+    return without_json_residue({**chained.result, "uncertainty": u.to_json_dict()})
