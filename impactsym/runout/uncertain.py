@@ -224,7 +224,7 @@ class Chained:
             rows = np.flatnonzero(reason == "")
             if rows.size:
                 start = self.p[k] + dx[rows] @ self.A[k].T
-                fit = fit_draws(table[rows], target[rows], start, self.J[k], vehicle)
+                fit = fit_draws(table[rows], target[rows], start, self.p[k], self.J[k], vehicle)
                 p[rows] = fit.state
                 self.work["runouts"] += fit.runouts
                 self.work["exact_rows"] += fit.exact_rows
