@@ -13,40 +13,16 @@ import pytest
 
 from impactsym.result import json_clean
 from impactsym.runout.batch import columns, runout_batch
-from impactsym.runout.chain import reconstruct_from_rest, solve_to_rest
+from impactsym.runout.chain import reconstruct_from_rest
 from impactsym.runout.uncertain import chained_uncertainty, load_chained, reconstruct_uncertainty
-from tests.helpers import EXAMPLES, one_line_error, run_cli
-
-CHAIN = EXAMPLES / "runout" / "chain_solve.json"
-
-
-def _rest_scene(wheels=None, sd_position=0.02, sd_heading=0.5, sd_friction=0.01) -> dict:
-    """chain_solve.json (impulse ratio 0.3, moment restitution 0.5: no draw near a
-    physics flag) run to rest, then turned round: the rest poses, each with a
-    normal sd, and the friction to `sd_friction`; `wheels` replaces both cars'."""
-    scene = json.loads(CHAIN.read_text())
-    scene["impact"].update(impulse_ratio=0.3, moment_restitution=0.5)
-    if wheels is not None:
-        for v in scene["vehicles"]:
-            v["wheels"] = wheels
-    forward = solve_to_rest(scene)
-    for key in ("restitution", "impulse_ratio", "moment_restitution"):
-        scene["impact"].pop(key)
-    for v, out in zip(scene["vehicles"], forward["vehicles"]):
-        v.pop("velocity")
-        rest = out["rest"]
-        v["rest"] = {
-            "position": [{"normal": [x, sd_position]} for x in rest["position"]],
-            "heading": {"normal": [rest["heading"], sd_heading]},
-        }
-    scene["runout"]["friction"] = {"normal": [0.75, sd_friction]}
-    return scene
+from tests.helpers import one_line_error, run_cli
+from tests.runout_rest import rest_scene
 
 
 @pytest.fixture(scope="module")
 def locked():
     """The all-locked scene and its propagation (4000 draws, seed 1)."""
-    scene = _rest_scene(wheels="locked")
+    scene = rest_scene(wheels="locked")
     return scene, chained_uncertainty(scene, draws=4000, seed=1)
 
 
@@ -145,7 +121,7 @@ def test_the_linear_prediction_is_a_first_order_taylor_expansion_input_by_input(
     spin), a miss that falls about fourfold when h halves (a wrong derivative
     leaves an O(h) miss, which only halves). Mixed wheels; uncertain tyre,
     wheel, body, heading and impact-point leaves."""
-    scene = _rest_scene(sd_position=0.05, sd_heading=1.0, sd_friction=0.02)
+    scene = rest_scene(sd_position=0.05, sd_heading=1.0, sd_friction=0.02)
     scene["runout"]["slip_angle_max"] = {"uniform": [8.0, 12.0]}
     scene["runout"]["rolling_resistance"] = {"triangular": [0.005, 0.01, 0.02]}
     scene["vehicles"][1]["wheels"]["rear_right"] = {"brake": {"normal": [0.3, 0.03]}}
@@ -169,7 +145,7 @@ def test_the_linear_prediction_is_a_first_order_taylor_expansion_input_by_input(
 
 
 def test_seeded_draws_are_reproducible_and_the_cli_is_the_api(capsys, tmp_path):
-    scene = _rest_scene(wheels="locked")
+    scene = rest_scene(wheels="locked")
     path = tmp_path / "rest.json"
     path.write_text(json.dumps(scene))
     api = reconstruct_uncertainty(scene, draws=300, seed=7)
@@ -191,7 +167,7 @@ def test_draws_outside_a_leaf_domain_are_rejected_by_reason():
     """Friction drawn as N(0.75, 0.35): the draws at or below 0 are rejected and
     counted under their reason; the others are fitted and accepted or
     rejected by the impact's flags."""
-    scene = _rest_scene(wheels="locked", sd_friction=0.35)
+    scene = rest_scene(wheels="locked", sd_friction=0.35)
     _, u = chained_uncertainty(scene, draws=400, seed=3)
     expected = int(np.count_nonzero(np.asarray(u.draws["runout.friction"]) <= 0))
     assert expected == 0  # accepted draws have positive friction
@@ -220,7 +196,7 @@ def test_draws_outside_a_leaf_domain_are_rejected_by_reason():
     ],
 )
 def test_bad_distributions_give_one_line_and_exit_2(capsys, tmp_path, edit, field):
-    scene = _rest_scene(wheels="locked")
+    scene = rest_scene(wheels="locked")
     edit(scene)
     path = tmp_path / "bad.json"
     path.write_text(json.dumps(scene))
@@ -230,14 +206,14 @@ def test_bad_distributions_give_one_line_and_exit_2(capsys, tmp_path, edit, fiel
 
 def test_too_few_draws_give_one_line_and_exit_2(capsys, tmp_path):
     path = tmp_path / "rest.json"
-    path.write_text(json.dumps(_rest_scene(wheels="locked")))
+    path.write_text(json.dumps(rest_scene(wheels="locked")))
     assert "--draws" in one_line_error(capsys, "reconstruct", path, "--uncertainty", "--draws", 10)
 
 
 def test_the_plain_command_solves_the_nominal_scene(capsys, tmp_path):
     """Without --uncertainty a scene with distributions on run-out leaves is
     reconstructed at their nominal values."""
-    scene = _rest_scene(wheels="locked")
+    scene = rest_scene(wheels="locked")
     path = tmp_path / "rest.json"
     path.write_text(json.dumps(scene))
     code, out, err = run_cli(capsys, "reconstruct", path, "--json")
