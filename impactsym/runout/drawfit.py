@@ -4,9 +4,9 @@
 
 Quasi-Newton across the rows, vectorised with NumPy, every run-out through
 `runout_batch` (forward only: no batch driver integrates the sensitivities).
-Each row starts from the better of its linear prediction (the nominal fit
-plus the linear method's dp/dx times the draw's deviation) and the nominal
-fitted state, with the exact Jacobian J = d(x, y, psi)_rest/d(vx, vy, w) of
+Each row starts from its linear prediction (the nominal fit plus the linear
+method's dp/dx times the draw's deviation) or, where that misses the rest
+pose by more than FAR, the nominal fitted state if it misses by less, with the exact Jacobian J = d(x, y, psi)_rest/d(vx, vy, w) of
 the nominal fit (integrated by the kernel; heading residuals weighted by the
 vehicle's R_max, as in fit.py). An iteration solves B s = -r for every open
 row (NumPy's batched 3x3 solve), shortens s to a trust region (`_capped`),
@@ -39,6 +39,7 @@ from .scene import RunoutVehicle
 MAX_ITERATIONS = 20  # batched trials before a row goes to the exact Newton
 GROWTH = 100.0  # a trial missing by more than this times the current miss is not taken
 STEP_SHARE, STEP_SPEED, STEP_YAW = 0.5, 2.0, 2.0  # trust region of a step (m/s, rad/s)
+FAR = 0.05  # m (heading weighted by R_max): a start missing by more also tries the nominal state
 STALL = 0.25  # a trial that does not cut the squared residual by this much renews the Jacobian
 FD_SHARE = 1e-3
 
@@ -91,18 +92,24 @@ def fit_draws(
     a, wb, track = (table[:, names.index(c)] for c in ("a", "L", "track"))
     radius = np.hypot(np.maximum(a, wb - a), track / 2)
     weight = np.column_stack([np.ones(n), np.ones(n), radius])  # heading residual in metres
-    # Two starts per row, the better one kept: the linear prediction, and the
-    # nominal state (where the run-out is strongly curved the prediction can
-    # land further off than the point it was taken at).
-    starts = np.vstack([start, np.broadcast_to(nominal, (n, 3))])
-    rs, ss = _residual(np.vstack([table, table]), starts, np.vstack([target, target]), tol)
-    rs *= np.vstack([weight, weight])
-    size = np.einsum("ni,ni->n", rs, rs)
-    second = (ss[n:] == 0) & ((ss[:n] != 0) | (size[n:] < size[:n]))
-    pick = np.where(second, np.arange(n, 2 * n), np.arange(n))
-    p, r, status = starts[pick].copy(), rs[pick], ss[pick]
+    p = np.array(start, dtype=np.float64, copy=True)
+    r, status = _residual(table, p, target, tol)
+    r *= weight
+    runouts = n
+    # Where the linear prediction misses by more than FAR, the nominal state is
+    # tried too and the better start kept (where the run-out is strongly
+    # curved the prediction can land further off than the point it was taken at).
+    far = np.flatnonzero((status != 0) | (np.einsum("ni,ni->n", r, r) > FAR**2))
+    if far.size:
+        other = np.broadcast_to(nominal, (far.size, 3))
+        ro, so = _residual(table[far], other, target[far], tol)
+        ro *= weight[far]
+        runouts += far.size
+        better = (so == 0) & (
+            (status[far] != 0) | (np.einsum("ni,ni->n", ro, ro) < np.einsum("ni,ni->n", r[far], r[far]))
+        )
+        p[far[better]], r[far[better]], status[far[better]] = other[better], ro[better], 0
     B = np.broadcast_to(jacobian, (n, 3, 3)) * weight[:, :, None]
-    runouts = 2 * n
     failed = status != 0
     open_ = ~failed & ~_done(r / weight)
     for _ in range(MAX_ITERATIONS):
