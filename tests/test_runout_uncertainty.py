@@ -221,3 +221,39 @@ def test_the_plain_command_solves_the_nominal_scene(capsys, tmp_path):
     plain = json.loads(out)
     assert plain["vehicles"][0]["speed"] == pytest.approx(17.0, abs=0.01)
     assert math.isclose(plain["vehicles"][1]["speed"], 8.0, abs_tol=0.01)
+
+
+def _in_us_units(scene: dict) -> dict:
+    """The SI scene in US units (slug, ft, slug ft^2), every number converted."""
+    ft, slug = 0.3048, 14.59390293720636
+
+    def length(x):
+        if isinstance(x, dict):
+            return {"normal": [x["normal"][0] / ft, x["normal"][1] / ft]}
+        return x / ft
+
+    out = copy.deepcopy(scene)
+    out["units"] = "US"
+    out["impact"]["position"] = [length(x) for x in out["impact"]["position"]]
+    for v in out["vehicles"]:
+        v["mass"] /= slug
+        v["yaw_inertia"] /= slug * ft**2
+        for key in ("wheelbase", "cg_to_front_axle", "track"):
+            v[key] /= ft
+        v["impact_point"] = [length(x) for x in v["impact_point"]]
+        v["rest"]["position"] = [length(x) for x in v["rest"]["position"]]
+    return out
+
+
+def test_a_us_scene_gives_the_si_answer_in_feet():
+    """The same scene in US units: nominal speeds, Monte Carlo sds and sd_linear
+    in ft/s are the SI ones over 0.3048 (same seed, same draws)."""
+    scene = rest_scene(wheels="locked")
+    _, si = chained_uncertainty(scene, draws=500, seed=4)
+    _, us = chained_uncertainty(_in_us_units(scene), draws=500, seed=4)
+    for path in ("vehicles[0].speed", "vehicles[1].speed", "vehicles[1].runout.separation.speed"):
+        for key in ("nominal", "sd", "sd_linear"):
+            assert us.outputs[path][key] * 0.3048 == pytest.approx(si.outputs[path][key], rel=2e-3), (
+                path,
+                key,
+            )
