@@ -15,7 +15,7 @@ from impactsym.result import json_clean
 from impactsym.runout.batch import columns, runout_batch
 from impactsym.runout.chain import reconstruct_from_rest
 from impactsym.runout.uncertain import chained_uncertainty, load_chained, reconstruct_uncertainty
-from tests.helpers import one_line_error, run_cli
+from tests.helpers import EXAMPLES, one_line_error, run_cli
 from tests.runout_rest import rest_scene
 
 
@@ -257,3 +257,19 @@ def test_a_us_scene_gives_the_si_answer_in_feet():
                 path,
                 key,
             )
+
+
+def test_what_is_not_propagated_through_the_run_out_is_one_line(capsys, tmp_path):
+    """--plot with --uncertainty, solve --uncertainty of a run-out scene, and
+    tyre-mark directions (not read by the batched fits) are refused, exit 2."""
+    scene = rest_scene(wheels="locked")
+    path = tmp_path / "rest.json"
+    path.write_text(json.dumps(scene))
+    png = tmp_path / "u.png"
+    assert "--plot" in one_line_error(capsys, "reconstruct", path, "--uncertainty", "--plot", png)
+    forward = EXAMPLES / "runout" / "chain_solve.json"
+    assert "--uncertainty" in one_line_error(capsys, "solve", forward, "--uncertainty", "--draws", 200)
+    scene["vehicles"][0]["separation"] = {"mark_directions": {"front_left": 10.0}}
+    path.write_text(json.dumps(scene))
+    err = one_line_error(capsys, "reconstruct", path, "--uncertainty", "--draws", 200)
+    assert "vehicles[0].separation.mark_directions" in err
