@@ -6,9 +6,10 @@ Quasi-Newton across the rows, vectorised with NumPy, every run-out through
 `runout_batch` (forward only: no batch driver integrates the sensitivities).
 Each row starts from its linear prediction (the nominal fit plus the linear
 method's dp/dx times the draw's deviation) or, where that misses the rest
-pose by more than FAR, the nominal fitted state if it misses by less, with the exact Jacobian J = d(x, y, psi)_rest/d(vx, vy, w) of
-the nominal fit (integrated by the kernel; heading residuals weighted by the
-vehicle's R_max, as in fit.py). An iteration solves B s = -r for every open
+pose by more than FAR, the nominal fitted state if it misses by less, with
+the exact Jacobian J = d(x, y, psi)_rest/d(vx, vy, w) of the nominal fit
+moved to first order to the draw (the caller's; heading residuals weighted by
+the vehicle's R_max, as in fit.py). An iteration solves B s = -r for every open
 row (NumPy's batched 3x3 solve), shortens s to a trust region (`_capped`),
 runs the trials, takes every trial whose run-out ran and whose miss did not
 grow more than GROWTH times (full, non-monotone steps: in the curved valleys
@@ -20,9 +21,11 @@ tolerances (0.1 mm, 1e-5 rad). Rows still open after MAX_ITERATIONS go to
 fit.py's exact Newton one by one; a row that does not converge there is
 reported as not fitted.
 
-Measured (examples/runout/chain_reconstruct_uncertain.json, 500 draws): 13
-run-outs per vehicle and draw for the spinning sedan, 12 of 1000 rows to the
-exact Newton; all wheels locked: 3.7 run-outs per vehicle and draw.
+Measured (`python -m benchmarks uncertainty --parts runout`): all wheels
+locked, 2.2 run-outs per vehicle and draw (1 for the start, 1 Newton step, a
+second for a fifth of the rows); the mixed-wheel example
+(examples/runout/chain_reconstruct_uncertain.json), whose sedan spins, about 13,
+and 1-2 % of its rows go to the exact Newton.
 """
 
 from __future__ import annotations
@@ -83,8 +86,8 @@ def fit_draws(
 ) -> DrawFit:
     """Fit rows of the run-out `table` (rows, COLUMNS; its vx, vy, w ignored)
     to `target` (rows, 3: x, y [m], psi [rad]) from `start` (rows, 3) or the
-    `nominal` fitted state (3,), whichever misses less, with `jacobian` (3x3 at
-    the nominal fit) as every row's first Jacobian.
+    `nominal` fitted state (3,), with `jacobian` (3x3, or rows x 3x3) as the
+    rows' first Jacobian.
     `vehicle` is the nominal RunoutVehicle (its row layout for the exact
     fallback)."""
     n = table.shape[0]
