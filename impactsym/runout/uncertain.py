@@ -124,7 +124,9 @@ class Chained:
     """A reconstruction from rest poses read for propagation (SI inside, scene
     units at the edges): the impact Scene with the nominal fitted final
     motion, the nominal run-out scene, the run-out leaves, the nominal fitted
-    states p (SI), their Jacobians J and linear predictions A (3 x inputs)."""
+    states p (SI), their Jacobians J, linear predictions A (3 x inputs) and
+    the Jacobians' slopes dJ (inputs x 3 x 3) along those predictions;
+    `work` counts the draws' run-outs, fitted rows and exact-Newton rows."""
 
     result: dict
     impact: object
