@@ -14,8 +14,16 @@ machine is shared; absolute times are noisy, ratios less so):
    code, take numba more than five minutes to compile: not measured).
 3. Peak resident memory of a child process streaming ``--stream`` draws,
    against a child streaming 2^18 draws (one chunk).
+4. ``reconstruct --uncertainty`` through the run-out (rest poses given),
+   ``--runout-draws`` draws end to end (reading, nominal fits, linearisation,
+   Monte Carlo with every draw's run-outs fitted, statistics, linear method)
+   after a first call of 200 draws, for an all-locked scene (tests/runout_rest.py)
+   and the mixed-wheel example examples/runout/chain_reconstruct_uncertain.json;
+   with the run-outs it took per draw and, as the baseline of the same run,
+   the run-outs per second of ``runout_batch`` on those scenes' nominal rows.
 
     python -m benchmarks uncertainty [--draws 1000000] [--stream 100000000]
+        [--runout-draws 100000] [--parts end_to_end,jacobian,stream,runout]
 """
 
 from __future__ import annotations
@@ -180,13 +188,72 @@ def stream_memory(draws: int) -> dict:
     return out
 
 
+def through_runout(draws: int, scene, label: str) -> dict:
+    """Part 4 for one scene (a path or mapping)."""
+    from impactsym.runout.batch import columns, runout_batch
+    from impactsym.runout.scene import row_values
+    from impactsym.runout.uncertain import chained_uncertainty
+
+    chained, _ = chained_uncertainty(scene, draws=200, seed=1)  # compile and warm up
+    start = time.perf_counter()
+    chained, u = chained_uncertainty(scene, draws=draws, seed=2)
+    elapsed = time.perf_counter() - start
+    rows = np.vstack(
+        [row_values(v, columns(), *p) for v, p in zip(chained.runout.vehicles, chained.p)] * 10_000
+    )
+    table = {c: rows[:, i] for i, c in enumerate(columns())}
+    runout_batch(table)
+    batch = _best(lambda: runout_batch(table), repeat=3)
+    work = chained.work
+    return {
+        "scene": label,
+        "draws": draws,
+        "accepted": u.accepted,
+        "seconds": round(elapsed, 2),
+        "runouts": work["runouts"],
+        "runouts_per_draw": round(work["runouts"] / draws, 2),
+        "exact_newton_rows": work["exact_rows"],
+        "batch_runouts_per_s": round(rows.shape[0] / batch),
+        "seconds_in_runouts_at_that_rate": round(work["runouts"] * batch / rows.shape[0], 2),
+    }
+
+
+PARTS = ("end_to_end", "jacobian", "stream", "runout")
+
+
 def add_arguments(parser) -> None:
     parser.add_argument("--draws", type=int, default=1_000_000, help="end-to-end draws")
     parser.add_argument("--stream", type=int, default=100_000_000, help="draws of the memory test")
+    parser.add_argument(
+        "--runout-draws",
+        type=int,
+        default=100_000,
+        help="draws of reconstruct --uncertainty through run-outs",
+    )
+    parser.add_argument(
+        "--runout-scenes", default="locked,mixed", help="run-out part: locked, mixed or both (default)"
+    )
+    parser.add_argument(
+        "--parts", default=",".join(PARTS), help=f"comma-separated parts to run (default {','.join(PARTS)})"
+    )
 
 
 def main(args) -> int:
-    print("end to end:", end_to_end(args.draws), flush=True)
-    print("jacobian vs value:", jacobian_vs_value(), flush=True)
-    print("streaming memory:", stream_memory(args.stream), flush=True)
+    parts = args.parts.split(",")
+    if "end_to_end" in parts:
+        print("end to end:", end_to_end(args.draws), flush=True)
+    if "jacobian" in parts:
+        print("jacobian vs value:", jacobian_vs_value(), flush=True)
+    if "stream" in parts:
+        print("streaming memory:", stream_memory(args.stream), flush=True)
+    if "runout" in parts:
+        from tests.runout_rest import rest_scene
+
+        scenes = {
+            "locked": lambda: rest_scene(wheels="locked", sd_position=0.1, sd_heading=2.0, sd_friction=0.05),
+            "mixed": lambda: "examples/runout/chain_reconstruct_uncertain.json",
+        }
+        for name in args.runout_scenes.split(","):
+            result = through_runout(args.runout_draws, scenes[name](), name)
+            print("through the run-out:", result, flush=True)
     return 0

@@ -76,19 +76,46 @@ def run_chained(args: argparse.Namespace, command: str) -> int:
     """``solve``/``reconstruct`` of a scene with run-out data (conventions.md,
     "Chained"): the command's JSON with each vehicle's run-out attached."""
     if getattr(args, "uncertainty", None):
-        raise SceneError(
-            "not yet available through the run-out from the command line "
-            "(impactsym.runout.interval.reconstruct_interval gives the intervals)",
-            "--uncertainty",
-        )
+        if command != "reconstruct":
+            raise SceneError("through the run-out only for reconstruct (rest poses)", "--uncertainty")
+        return _run_chained_uncertainty(args)
     if getattr(args, "plot", None):
         raise SceneError("draw a chained scene's run-outs with impactsym runout SCENE --plot", "--plot")
     from .chain import reconstruct_from_rest, solve_to_rest
+    from .uncertain import nominal_data
 
-    result = without_json_residue(
-        (solve_to_rest if command == "solve" else reconstruct_from_rest)(args.scene)
-    )
+    if command == "solve":
+        result = solve_to_rest(args.scene)
+    else:  # distributions on the run-out's leaves: the nominal scene, as every plain command
+        result = reconstruct_from_rest(nominal_data(args.scene)[0])
+    result = without_json_residue(result)
     print(json.dumps(json_clean(result), indent=2) if args.json else _chain_table(result))
+    return 0
+
+
+def _run_chained_uncertainty(args: argparse.Namespace) -> int:
+    """``reconstruct SCENE --uncertainty`` of a scene with rest poses (uncertain.py)."""
+    from ..uncertainty.cli import DEFAULT_DRAWS
+    from ..uncertainty.result import MIN_INTERVAL_DRAWS
+    from .uncertain import chained_uncertainty, uncertainty_json
+
+    if getattr(args, "plot", None):
+        raise SceneError("not drawn for a scene with rest poses; leave out --plot", "--plot")
+    draws = DEFAULT_DRAWS if args.draws is None else args.draws
+    if draws < MIN_INTERVAL_DRAWS:
+        raise SceneError(
+            f"{draws} draws cannot give a 90 % interval; give at least {MIN_INTERVAL_DRAWS}", "--draws"
+        )
+    try:
+        chained, u = chained_uncertainty(args.scene, draws=draws, seed=args.seed, sobol=args.sobol)
+    except (ValueError, ImportError) as exc:  # a one-line reason, exit code 2
+        raise SceneError(str(exc)) from None
+    if args.json:
+        print(json.dumps(json_clean(uncertainty_json(chained, u)), indent=2, allow_nan=False))
+    else:
+        print(_chain_table(without_json_residue(chained.result)))
+        print()
+        print(u.table())
     return 0
 
 

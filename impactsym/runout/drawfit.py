@@ -1,0 +1,205 @@
+"""Fit many run-outs to their rest poses at once: one separation state
+(vx, vy, w) per row of a run-out table, for the Monte Carlo draws of
+``reconstruct --uncertainty`` through the run-out (uncertain.py).
+
+Quasi-Newton across the rows, vectorised with NumPy, every run-out through
+`runout_batch` (forward only: no batch driver integrates the sensitivities).
+Each row starts from its linear prediction (the nominal fit plus the linear
+method's dp/dx times the draw's deviation) or, where that misses the rest
+pose by more than FAR, the nominal fitted state if it misses by less, with
+the exact Jacobian J = d(x, y, psi)_rest/d(vx, vy, w) of the nominal fit
+moved to first order to the draw (the caller's; heading residuals weighted by
+the vehicle's R_max, as in fit.py). An iteration solves B s = -r for every open
+row (NumPy's batched 3x3 solve), shortens s to a trust region (`_capped`),
+runs the trials, takes every trial whose run-out ran and whose miss did not
+grow more than GROWTH times (full, non-monotone steps: in the curved valleys
+of a spinning car a Newton step may first miss by more and then converge,
+where a descent rule crawls), and updates B by Broyden's rank-one formula.
+A row whose trial did not cut its squared miss fourfold gets a fresh B from
+forward differences of three run-outs. A row is converged at fit.py's
+tolerances (0.1 mm, 1e-5 rad). Rows still open after MAX_ITERATIONS go to
+fit.py's exact Newton one by one; a row that does not converge there is
+reported as not fitted.
+
+Measured (`python -m benchmarks uncertainty --parts runout`): all wheels
+locked, 2.2 run-outs per vehicle and draw (1 for the start, 1 Newton step, a
+second for a fifth of the rows); the mixed-wheel example
+(examples/runout/chain_reconstruct_uncertain.json), whose sedan spins, about 13,
+and 1-2 % of its rows go to the exact Newton.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from .batch import columns, runout_batch
+from .fit import HEADING_TOL, POSITION_TOL, newton
+from .scene import RunoutVehicle
+
+MAX_ITERATIONS = 20  # batched trials before a row goes to the exact Newton
+GROWTH = 100.0  # a trial missing by more than this times the current miss is not taken
+STEP_SHARE, STEP_SPEED, STEP_YAW = 0.5, 2.0, 2.0  # trust region of a step (m/s, rad/s)
+FAR = 0.05  # m (heading weighted by R_max): a start missing by more also tries the nominal state
+STALL = 0.25  # a trial that does not cut the squared residual by this much renews the Jacobian
+FD_SHARE = 1e-3
+
+#: Why a row was not fitted (the fitted state is NaN there).
+NOT_CONVERGED = 1
+RUN_FAILED = 2
+
+
+@dataclasses.dataclass
+class DrawFit:
+    """The fitted states (rows, 3) [SI], per row 0 or NOT_CONVERGED/RUN_FAILED,
+    and the work done: forward run-outs in the batch, rows refitted exactly."""
+
+    state: np.ndarray
+    status: np.ndarray
+    runouts: int
+    exact_rows: int
+
+
+def _residual(table: np.ndarray, p: np.ndarray, target: np.ndarray, tol):
+    """Rest-pose residuals (rows, 3) of the separation states p, and the kernel status."""
+    cols = {name: table[:, j] for j, name in enumerate(columns())}
+    cols["vx"], cols["vy"], cols["w"] = p[:, 0], p[:, 1], p[:, 2]
+    out = runout_batch(cols, tol=tol)
+    rest = np.column_stack([out["x_rest"], out["y_rest"], out["psi_rest"]])
+    return rest - target, out["status"]
+
+
+def _done(r: np.ndarray) -> np.ndarray:
+    return (np.hypot(r[:, 0], r[:, 1]) < POSITION_TOL) & (np.abs(r[:, 2]) < HEADING_TOL)
+
+
+def fit_draws(
+    table: np.ndarray,
+    target: np.ndarray,
+    start: np.ndarray,
+    nominal: np.ndarray,
+    jacobian: np.ndarray,
+    vehicle: RunoutVehicle,
+    tol: float | None = None,
+) -> DrawFit:
+    """Fit rows of the run-out `table` (rows, COLUMNS; its vx, vy, w ignored)
+    to `target` (rows, 3: x, y [m], psi [rad]) from `start` (rows, 3) or the
+    `nominal` fitted state (3,), with `jacobian` (3x3, or rows x 3x3) as the
+    rows' first Jacobian.
+    `vehicle` is the nominal RunoutVehicle (its row layout for the exact
+    fallback)."""
+    n = table.shape[0]
+    names = columns()
+    a, wb, track = (table[:, names.index(c)] for c in ("a", "L", "track"))
+    radius = np.hypot(np.maximum(a, wb - a), track / 2)
+    weight = np.column_stack([np.ones(n), np.ones(n), radius])  # heading residual in metres
+    p = np.array(start, dtype=np.float64, copy=True)
+    r, status = _residual(table, p, target, tol)
+    r *= weight
+    runouts = n
+    # Where the linear prediction misses by more than FAR, the nominal state is
+    # tried too and the better start kept (where the run-out is strongly
+    # curved the prediction can land further off than the point it was taken at).
+    far = np.flatnonzero((status != 0) | (np.einsum("ni,ni->n", r, r) > FAR**2))
+    if far.size:
+        other = np.broadcast_to(nominal, (far.size, 3))
+        ro, so = _residual(table[far], other, target[far], tol)
+        ro *= weight[far]
+        runouts += far.size
+        better = (so == 0) & (
+            (status[far] != 0) | (np.einsum("ni,ni->n", ro, ro) < np.einsum("ni,ni->n", r[far], r[far]))
+        )
+        p[far[better]], r[far[better]], status[far[better]] = other[better], ro[better], 0
+    B = np.broadcast_to(jacobian, (n, 3, 3)) * weight[:, :, None]
+    failed = status != 0
+    open_ = ~failed & ~_done(r / weight)
+    for _ in range(MAX_ITERATIONS):
+        rows = np.flatnonzero(open_)
+        if rows.size == 0:
+            break
+        step = _capped(_newton_step(B[rows], r[rows]), p[rows])
+        trial = p[rows] + step
+        rt, st = _residual(table[rows], trial, target[rows], tol)
+        rt *= weight[rows]
+        runouts += rows.size
+        before, after = np.einsum("ni,ni->n", r[rows], r[rows]), np.einsum("ni,ni->n", rt, rt)
+        # Full steps, not monotone: in a curved valley a Newton step may first
+        # miss by more and then converge (a descent rule crawls there).
+        take = (st == 0) & (after < GROWTH**2 * before)
+        _broyden(B, rows[take], step[take], rt[take] - r[rows[take]])
+        p[rows[take]], r[rows[take]] = trial[take], rt[take]
+        open_[rows[take]] = ~_done(rt[take] / weight[rows[take]])
+        slow = rows[open_[rows] & ~(take & (after < STALL * before))]
+        if slow.size:  # Broyden's Jacobian is not leading: differences of forward run-outs instead
+            B[slow] = _differences(table[slow], p[slow], r[slow], target[slow], weight[slow], tol)
+            runouts += 3 * slow.size
+    exact = np.flatnonzero(open_)
+    for i in exact:
+        fit = newton(_variant(vehicle, table[i], target[i]), tuple(p[i]), tol)
+        if fit.converged:
+            p[i] = (*fit.velocity, fit.yaw_rate)
+            open_[i] = False
+    out = np.where(failed, RUN_FAILED, np.where(open_, NOT_CONVERGED, 0))
+    p[out != 0] = math.nan
+    return DrawFit(p, out, runouts, int(exact.size))
+
+
+def _differences(table, p, r, target, weight, tol) -> np.ndarray:
+    """Jacobians (rows, 3, 3) of the weighted residual by forward differences of
+    forward run-outs (steps 1e-4 of the speed or yaw rate, at least 1e-4)."""
+    m = p.shape[0]
+    h = np.column_stack(
+        [np.maximum(FD_SHARE * np.hypot(p[:, 0], p[:, 1]), FD_SHARE)] * 2
+        + [np.maximum(FD_SHARE * np.abs(p[:, 2]), FD_SHARE)]
+    )
+    moved = np.repeat(p[None], 3, axis=0)
+    for j in range(3):
+        moved[j, :, j] += h[:, j]
+    rt, _ = _residual(np.tile(table, (3, 1)), moved.reshape(3 * m, 3), np.tile(target, (3, 1)), tol)
+    rt = rt.reshape(3, m, 3) * weight[None]
+    return np.stack([(rt[j] - r) / h[:, j, None] for j in range(3)], axis=2)
+
+
+def _newton_step(B: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Newton steps B s = -r, row by row (NumPy's batched 3x3 solve; a singular
+    B gives the least-squares step)."""
+    try:
+        return np.linalg.solve(B, -r[:, :, None])[:, :, 0]
+    except np.linalg.LinAlgError:
+        return np.stack([np.linalg.lstsq(b, -x, rcond=None)[0] for b, x in zip(B, r)])
+
+
+def _capped(step: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """`step` shortened to the trust region: the velocity change at most
+    STEP_SHARE of the speed (and at least STEP_SPEED m/s), the yaw-rate change
+    at most STEP_SHARE of |w| (at least STEP_YAW rad/s). A trial far outside it
+    can roll for minutes of simulated time and hold up the whole batch."""
+    dv = np.hypot(step[:, 0], step[:, 1]) / np.maximum(STEP_SHARE * np.hypot(p[:, 0], p[:, 1]), STEP_SPEED)
+    dw = np.abs(step[:, 2]) / np.maximum(STEP_SHARE * np.abs(p[:, 2]), STEP_YAW)
+    return step / np.maximum(1.0, np.maximum(dv, dw))[:, None]
+
+
+def _broyden(B: np.ndarray, rows: np.ndarray, s: np.ndarray, y: np.ndarray) -> None:
+    """Broyden's update of the Jacobians B[rows] from steps s and residual
+    changes y: B += (y - B s) s' / (s' s)."""
+    if rows.size == 0:
+        return
+    Bs = np.einsum("nij,nj->ni", B[rows], s)
+    ss = np.einsum("ni,ni->n", s, s)
+    ok = ss > 0
+    B[rows[ok]] += (y - Bs)[ok, :, None] * s[ok, None, :] / ss[ok, None, None]
+
+
+def _variant(vehicle: RunoutVehicle, row: np.ndarray, target: np.ndarray) -> RunoutVehicle:
+    """The nominal vehicle with one drawn row and rest pose (fit.newton's input)."""
+    values = dict(zip(columns(), (float(x) for x in row)))
+    return dataclasses.replace(
+        vehicle,
+        row={k: values[k] for k in vehicle.row},
+        position=(values["x"], values["y"]),
+        heading=values["psi"],
+        rest=tuple(float(x) for x in target),
+        marks={},
+    )
