@@ -31,7 +31,7 @@ from .result import Result
 from .runout import runout, runout_batch
 from .scene import MODELS, Impact, Scene, SceneError, Vehicle, load_scene
 from .single import solve
-from .uncertainty import uncertainty
+from .uncertain_scene import uncertainty
 
 __all__ = [
     "FLAG_MESSAGES",

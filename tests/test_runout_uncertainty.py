@@ -163,6 +163,23 @@ def test_seeded_draws_are_reproducible_and_the_cli_is_the_api(capsys, tmp_path):
         assert set(o) == {"nominal", "mean", "sd", "p5", "p50", "p95", "sd_linear", "budget"}
 
 
+def test_the_package_uncertainty_routes_a_rest_scene_through_the_run_out(tmp_path):
+    """``impactsym.uncertainty(scene, command="reconstruct")`` of a scene with rest
+    poses is the propagation through its run-outs (path and mapping alike); ``solve``
+    of it is the engine's, which refuses the run-out object."""
+    import impactsym
+
+    scene = rest_scene(wheels="locked")
+    path = tmp_path / "rest.json"
+    path.write_text(json.dumps(scene))
+    want = json_clean(chained_uncertainty(scene, draws=300, seed=7)[1].to_json_dict())
+    for given in (scene, str(path)):
+        got = impactsym.uncertainty(given, command="reconstruct", draws=300, seed=7).to_json_dict()
+        assert json_clean(got) == want
+    with pytest.raises(ValueError, match="runout"):  # solve through the run-out is the CLI's refusal too
+        impactsym.uncertainty(scene, command="solve", draws=300, seed=7)
+
+
 def test_draws_outside_a_leaf_domain_are_rejected_by_reason():
     """Friction drawn as N(0.75, 0.35): the draws at or below 0 are rejected and
     counted under their reason; the others are fitted and accepted or

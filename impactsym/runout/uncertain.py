@@ -49,9 +49,9 @@ from ..residue import without_json_residue
 from ..scene import load_scene, scene_columns, scene_data
 from ..scene.casefile import LeafReader, domain_reasons, parse_correlations, vehicle_state
 from ..uncertainty import Source, propagate
-from ..uncertainty import propagation as engine
 from ..uncertainty.commands import RECONSTRUCT, Command
-from ..uncertainty.inputs import Input, correlation_matrix
+from ..uncertainty.inputs import Input
+from ..uncertainty.propagation import linear_method
 from .batch import columns, run_row, runout_batch
 from .chain import _check, _impact_part, reconstruct_from_rest
 from .drawfit import NOT_CONVERGED, fit_draws
@@ -441,11 +441,9 @@ def chained_uncertainty(scene, draws: int = 10_000, seed: int | None = None, sob
         chained.linear_columns,
         chained.correlations,
     )
-    gradients = engine._gradients(linear, engine._nominal(linear))
-    sd = np.array([x.sd for x in chained.inputs])
-    cov = correlation_matrix(chained.inputs, chained.correlations) * np.outer(sd, sd)
+    first_order = linear_method(linear)
     for path, stats in u.outputs.items():
-        stats["sd_linear"], u.budget[path] = engine._linear(gradients.get(path), cov, chained.inputs)
+        stats["sd_linear"], u.budget[path] = first_order.get(path, (math.nan, {}))
     return chained, u
 
 

@@ -142,12 +142,11 @@ def propagate(
         rows=draws,
     )
     stats, accepted, rejected, kept = _monte_carlo(source, plan, factor, nominal, chunk_size)
-    gradient = _gradients(source, nominal)
-    cov = corr * np.outer([x.sd for x in source.inputs], [x.sd for x in source.inputs])
+    linear = linear_method(source, nominal)
     outputs, budget = {}, {}
     for path, s in stats.items():
         p5, p50, p95 = s.percentiles()
-        sd_lin, shares = _linear(gradient.get(path), cov, source.inputs)
+        sd_lin, shares = linear.get(path, (math.nan, {}))
         outputs[path] = {
             "nominal": nominal["outputs"][path],
             "mean": s.mean,
@@ -173,6 +172,16 @@ def propagate(
     if sobol:
         result.sobol = sobol_indices(source, draws, seed, stats)
     return result
+
+
+def linear_method(source: Source, nominal: dict | None = None) -> dict:
+    """{output path: (sd_linear, budget)}: the first-order method at the
+    nominal scene (`nominal`, as `_nominal` gives it, when already known)
+    from the exact derivatives, with the inputs' correlations."""
+    gradient = _gradients(source, _nominal(source) if nominal is None else nominal)
+    sd = np.array([x.sd for x in source.inputs])
+    cov = correlation_matrix(source.inputs, source.correlations) * np.outer(sd, sd)
+    return {path: _linear(g, cov, source.inputs) for path, g in gradient.items()}
 
 
 def _monte_carlo(source: Source, plan: SamplePlan, factor: np.ndarray, nominal: dict, chunk_size: int):
