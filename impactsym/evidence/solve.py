@@ -32,6 +32,7 @@ import numpy as np
 from ..errors import SceneError
 from .case import STATE, FitCase
 from .model import Model
+from .rest_refit import draw_values
 
 RANK_TOL = 1e-9
 DETERMINED_TOL = 1e-6
@@ -228,23 +229,35 @@ class Identifiability:
 
 
 def draw_fits(model: Model, xp, N, u_hat, ident: Identifiability, linear: bool, draws: int, seed: int):
-    """Monte Carlo over the evidence: the unknowns x of each accepted draw."""
+    """Monte Carlo over the evidence: (the unknowns x of each accepted draw,
+    rest-pose refits that failed). A linear problem without rest poses draws x
+    from its Gaussian; otherwise each draw redraws every observation value
+    (rest poses refitted through the run-out, rest_refit.py) and refits."""
     rng = np.random.default_rng(seed)
-    out = []
-    if linear:
+    rest = model.case.rest
+    if linear and rest is None:
         cov = ident.cov
         w, v = np.linalg.eigh((cov + cov.T) / 2)
         root = v * np.sqrt(np.clip(w, 0, None))
         x_hat = xp + N @ u_hat
-        return [x_hat + root @ rng.standard_normal(len(w)) for _ in range(draws)]
-    for _ in range(draws):
-        values = model.values + model.sd * rng.standard_normal(len(model.sd))
+        return [x_hat + root @ rng.standard_normal(len(w)) for _ in range(draws)], 0
+    values = model.values + model.sd * rng.standard_normal((draws, len(model.sd)))
+    failed = 0
+    if rest is not None:
+        values[:, rest.rows], failed = draw_values(rest, rng, draws)
+    out = []
+    for drawn in values:
+        if not np.all(np.isfinite(drawn)):
+            continue
+        if linear:
+            out.append(xp + N @ linear_solve(model, xp, N, drawn))
+            continue
         try:
-            u, _ = gauss_newton(model, xp, N, u_hat, values=values, max_iter=20)
+            u, _ = gauss_newton(model, xp, N, u_hat, values=drawn, max_iter=20)
         except SceneError:
             continue
         out.append(xp + N @ u)
-    return out
+    return out, failed
 
 
 def fit_case(case: FitCase, draws: int = 400, seed: int = 0, method: str = "auto"):
@@ -260,14 +273,26 @@ def fit_case(case: FitCase, draws: int = 400, seed: int = 0, method: str = "auto
     x_hat = xp + N @ u_hat
     y, J = model.predict(x_hat)
     ident = Identifiability(model.whitened(y, J)[1], N)
-    samples = draw_fits(model, xp, N, u_hat, ident, linear, draws, seed) if draws else []
+    samples, failed = draw_fits(model, xp, N, u_hat, ident, linear, draws, seed) if draws else ([], 0)
     info = {
         "linear": linear,
+        "intervals": _intervals(linear, case, draws),
         "iterations": iterations,
         "converged": iterations < MAX_ITERATIONS,
         "method": "closed form" if iterations == 0 else "gauss-newton",
     }
+    if case.rest is not None and draws:
+        info["rest_refits_failed"] = failed
     return model, x_hat, y, ident, samples, info
+
+
+def _intervals(linear: bool, case: FitCase, draws: int) -> str:
+    """How the answer's 90 % intervals are found (``method.intervals``)."""
+    if linear and (case.rest is None or not draws):
+        return "gaussian" + (" (rest poses linearised)" if case.rest is not None else "")
+    if not draws:
+        return "linearised (no draws)"
+    return "monte carlo over the evidence" + (", rest poses refitted" if case.rest is not None else "")
 
 
 __all__ = ["STATE", "fit_case"]
