@@ -312,7 +312,10 @@ def _crush_kernel() -> Kernel:
         inputs=(E_absorbed, e),
         checks=(
             finite_inputs((E_absorbed, e)),
-            Guard((sp.GreaterThan(E_absorbed, 0), sp.GreaterThan(e, 0), sp.LessThan(e, 1)), "ENERGY_INCONSISTENT"),
+            Guard(
+                (sp.GreaterThan(E_absorbed, 0), sp.GreaterThan(e, 0), sp.LessThan(e, 1)),
+                "ENERGY_INCONSISTENT",
+            ),
         ),
         blocks=(
             Block(

@@ -170,7 +170,9 @@ def test_the_absorbed_reading_is_the_crash3_codes_own():
     e = 0.3
     t = truth(19)
     scene = absorbed_scene(t, e)
-    (energy,) = [r for r in fit(scene, draws=0).to_json_dict()["residuals"] if r["label"].startswith("energy")]
+    (energy,) = [
+        r for r in fit(scene, draws=0).to_json_dict()["residuals"] if r["label"].startswith("energy")
+    ]
     vehicles = [
         {k: v for k, v in vehicle.items() if k != "heading"} | {"crush": scene["evidence"][3 + i]["crush"]}
         for i, vehicle in enumerate(scene["vehicles"])

@@ -150,7 +150,9 @@ def read_case(source: Mapping | str | Path) -> FitCase:
             observations += edr_observations(item, k, units, names, fixed, source, warnings)
         elif isinstance(item, Mapping) and item.get("quantity") == "rest":
             check_keys(item, EVIDENCE_KEYS, f"evidence[{k}]")
-            rests.append((len(observations), read_rest(item, k, data, (units, names, fixed, params), warnings)))
+            rests.append(
+                (len(observations), read_rest(item, k, data, (units, names, fixed, params), warnings))
+            )
         else:
             item = with_profile_energy(item, k, data, names, fixed, warnings)
             observations += read_item(item, k, units, names, fixed)

@@ -172,7 +172,9 @@ def read_item(item: Any, k: int, units: str, names, fixed) -> list[Observation]:
     return [Observation(k, label, value, sd, how, angle=dimension == "angle")]
 
 
-def crush_energies(observations: list[Observation], fixed, absorbed: float | None = None) -> list[Observation]:
+def crush_energies(
+    observations: list[Observation], fixed, absorbed: float | None = None
+) -> list[Observation]:
     """The crush energies of the vehicles together are the energy loss (each
     already an energy lost over the impact: CRASH3's "dissipated", or its
     "absorbed" times (1 - e^2), crush_item.as_energy_lost). Given for every
