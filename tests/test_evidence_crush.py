@@ -204,3 +204,21 @@ def test_an_unused_vehicle_crush_block_is_named_in_the_warnings():
     got = fit(scene, draws=0).to_json_dict()
     assert any(w.startswith("vehicles[1].crush is not used") for w in got["warnings"])
     assert not any(w.startswith("vehicles[0].crush is not used") for w in got["warnings"])
+
+
+def test_a_crash3_restitution_the_fit_rules_out_is_named():
+    """The absorbed reading uses crash3.restitution, not the fitted e: when the
+    fitted e's 90 % interval excludes it the answer says the two readings
+    disagree; at the truth's own e it does not."""
+    t = truth(19)
+    said = "outside the fitted restitution's 90 % interval"
+    near = fit(absorbed_scene(t, t["row"]["e"]), draws=200, seed=1)
+    assert near.estimates["restitution"].determined
+    assert not any(said in w for w in near.warnings)
+    far = fit(absorbed_scene(t, 0.9), draws=200, seed=1)
+    low, high = far.estimates["restitution"].interval
+    assert not low <= 0.9 <= high
+    assert any(
+        w.startswith("the crush energies were read as absorbed with crash3.restitution 0.9")
+        for w in far.warnings
+    )
