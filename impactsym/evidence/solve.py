@@ -20,7 +20,10 @@ constraint R_em = 0, removed by parametrising x = xp + N u.
 - Intervals (90 %): affine quantities of a linear problem from the Gaussian
   covariance (±1.645 σ, exact); everything else by Monte Carlo over the
   evidence (each value redrawn from its normal, refitted; a linear problem
-  draws x from its Gaussian directly): 5th and 95th percentiles.
+  without rest poses draws x from its Gaussian directly; rest poses and
+  their frictions are redrawn and refitted through the run-out,
+  rest_refit.py, since their observations are a linearisation): 5th and
+  95th percentiles.
 """
 
 from __future__ import annotations
