@@ -84,26 +84,39 @@ class RestFit:
         """The fitted separation state, scene units."""
         return np.array([*self.fit.velocity, self.fit.yaw_rate]) * self.to_scene
 
-    def spread(self) -> np.ndarray:
-        """3 x 3, scene units: column j is the separation state's change per sd of rest coordinate j."""
-        return self.sensitivity[:, :3] * self.sigma * self.to_scene[:, None]
-
-    def per_friction(self) -> np.ndarray:
-        """d(separation state)/dμ at the measured rest pose, scene units."""
-        return self.sensitivity[:, 3] * self.to_scene
-
 
 @dataclass
 class RestEvidence:
     """Every rest item of a fit, whitened together: `rows` are the indices of
     their observations in the case's list (in the order of the stacked
-    states), `unit_lower` the whitening (observation values = unit_lower @ P),
-    `frictions` each friction source's (mean, sd)."""
+    states), `frictions` each friction source's (mean, sd)."""
 
     items: list[RestFit]
-    unit_lower: np.ndarray
     frictions: dict
     rows: list[int] = dataclasses.field(default_factory=list)
+
+    @property
+    def outputs(self) -> list[str]:
+        """The stacked separation states' outputs (V1x, V1y, W1, ...), in row order."""
+        return [name for rest in self.items for name in rest.outputs]
+
+    def whitening(self, sensitivities=None):
+        """(unit_lower, sd): the observations of the stacked states P are
+        unit_lower @ P with sds `sd` (module docstring), from each item's
+        sensitivities (3 x 4 SI; default: at its fitted state)."""
+        size = 3 * len(self.items)
+        cov = np.zeros((size, size))
+        shared = {name: np.zeros(size) for name in self.frictions}
+        for j, rest in enumerate(self.items):
+            sens = rest.sensitivity if sensitivities is None else sensitivities[j]
+            block = slice(3 * j, 3 * j + 3)
+            spread = sens[:, :3] * rest.sigma * rest.to_scene[:, None]
+            cov[block, block] = spread @ spread.T
+            shared[rest.friction][block] = sens[:, 3] * rest.to_scene
+        for name, (_, sd) in self.frictions.items():
+            cov += sd**2 * np.outer(shared[name], shared[name])
+        chol = np.linalg.cholesky((cov + cov.T) / 2)
+        return np.diag(np.diag(chol)) @ np.linalg.inv(chol), np.diag(chol).copy()
 
 
 def read_rest(item: Mapping, k: int, data: Mapping, case_values, warnings: list) -> RestFit:
@@ -174,30 +187,20 @@ def friction_prior(raw, path: str) -> tuple[float, float]:
 def rest_evidence(rests: list[RestFit], sources: dict) -> tuple[list[Observation], RestEvidence]:
     """The whitened observations of every rest item together (module
     docstring), in item order, and the record the Monte Carlo redraws."""
-    size = 3 * len(rests)
-    cov = np.zeros((size, size))
-    shared = {name: np.zeros(size) for name in sources}
-    for j, rest in enumerate(rests):
-        block = slice(3 * j, 3 * j + 3)
-        spread = rest.spread()
-        cov[block, block] = spread @ spread.T
-        shared[rest.friction][block] = rest.per_friction()
-    for name, (_, sd) in sources.items():
-        cov += sd**2 * np.outer(shared[name], shared[name])
+    evidence = RestEvidence(rests, dict(sources))
     try:
-        chol = np.linalg.cholesky((cov + cov.T) / 2)
+        unit_lower, sd = evidence.whitening()
     except np.linalg.LinAlgError:
         raise SceneError(
             "the rest pose does not fix the separation state (singular covariance)",
             f"evidence[{rests[0].evidence}]",
         ) from None
-    unit_lower = np.diag(np.diag(chol)) @ np.linalg.inv(chol)  # rows: 1 on the diagonal
     states = np.concatenate([rest.state() for rest in rests])
-    outputs = [name for rest in rests for name in rest.outputs]
+    outputs = evidence.outputs
     observations = []
-    for row in range(size):
+    for row in range(len(outputs)):
         rest = rests[row // 3]
-        given = "" if row % 3 == 0 and not np.any(unit_lower[row, :row]) else " (whitened)"
+        given = " (whitened)" if np.any(unit_lower[row, :row]) else ""
         combination = tuple(
             (float(unit_lower[row, m]), outputs[m]) for m in range(row + 1) if unit_lower[row, m] != 0.0
         )
@@ -206,11 +209,11 @@ def rest_evidence(rests: list[RestFit], sources: dict) -> tuple[list[Observation
                 rest.evidence,
                 f"{rest.label}: {LABELS[row % 3]}{given}",
                 float(unit_lower[row] @ states),
-                float(chol[row, row]),
+                float(sd[row]),
                 ("combination", combination),
             )
         )
-    return observations, RestEvidence(rests, unit_lower, dict(sources))
+    return observations, evidence
 
 
 def linearity_warnings(evidence: RestEvidence) -> list[str]:

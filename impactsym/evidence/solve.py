@@ -35,7 +35,7 @@ import numpy as np
 from ..errors import SceneError
 from .case import STATE, FitCase
 from .model import Model
-from .rest_refit import draw_values
+from .rest_refit import draw_whitened
 
 RANK_TOL = 1e-9
 DETERMINED_TOL = 1e-6
@@ -245,22 +245,51 @@ def draw_fits(model: Model, xp, N, u_hat, ident: Identifiability, linear: bool, 
         x_hat = xp + N @ u_hat
         return [x_hat + root @ rng.standard_normal(len(w)) for _ in range(draws)], 0
     values = model.values + model.sd * rng.standard_normal((draws, len(model.sd)))
-    failed = 0
-    if rest is not None:
-        values[:, rest.rows], failed = draw_values(rest, rng, draws)
-    out = []
-    for drawn in values:
-        if not np.all(np.isfinite(drawn)):
-            continue
-        if linear:
-            out.append(xp + N @ linear_solve(model, xp, N, drawn))
-            continue
-        try:
-            u, _ = gauss_newton(model, xp, N, u_hat, values=drawn, max_iter=20)
-        except SceneError:
-            continue
-        out.append(xp + N @ u)
+    whitened = draw_whitened(rest, rng, draws) if rest is not None else [None] * draws
+    saved = model.a.copy(), model.B.copy(), model.sd.copy()
+    outputs = _outputs(model, rest.outputs) if rest is not None else None
+    out, failed = [], 0
+    try:
+        for drawn, rest_rows in zip(values, whitened):
+            if rest is not None:
+                if rest_rows is None:
+                    failed += 1
+                    continue
+                _reweigh(model, rest.rows, outputs, rest_rows, drawn)
+            x = _refit(model, xp, N, u_hat, linear, drawn)
+            if x is not None:
+                out.append(x)
+    finally:
+        model.a, model.B, model.sd = saved
     return out, failed
+
+
+def _outputs(model: Model, names) -> tuple[np.ndarray, np.ndarray]:
+    """(a, B): evidence_linear outputs `names` as a + B x in the unknowns."""
+    pairs = [model.affine(name) for name in names]
+    case = model.case
+    return np.array([a + b @ case.z0 for a, b in pairs]), np.array([b @ case.T for _, b in pairs])
+
+
+def _reweigh(model: Model, rows, outputs, rest_rows, drawn) -> None:
+    """Set the rest observations' rows of `model` (offsets, Jacobian rows,
+    sds) and their values in `drawn` to one Monte Carlo draw's whitening
+    (rest_refit.draw_whitened); `outputs` = (a, B) of the stacked states."""
+    unit_lower, sd, states = rest_rows
+    a, B = outputs
+    model.a[rows], model.B[rows], model.sd[rows] = unit_lower @ a, unit_lower @ B, sd
+    drawn[rows] = unit_lower @ states
+
+
+def _refit(model: Model, xp, N, u_hat, linear: bool, values):
+    """The unknowns x fitted to one draw's `values` (None if Gauss–Newton fails)."""
+    if linear:
+        return xp + N @ linear_solve(model, xp, N, values)
+    try:
+        u, _ = gauss_newton(model, xp, N, u_hat, values=values, max_iter=20)
+    except SceneError:
+        return None
+    return xp + N @ u
 
 
 def fit_case(case: FitCase, draws: int = 400, seed: int = 0, method: str = "auto"):
