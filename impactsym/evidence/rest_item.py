@@ -23,8 +23,9 @@ with the Cholesky factor C = L Lᵀ in its unit-lower form: observation i is
 (L_ii L⁻¹)_i · P with sd L_ii (V_1x, then V_1y given V_1x, ...; the sum of the
 squared residuals is the full-covariance one). This linearisation weights the
 fit and gives its point estimate; the intervals come from Monte Carlo refits
-of drawn rest poses and frictions (rest_refit.py), since the run-out is far
-from linear over a rest pose's spread for some wheel setups.
+of drawn rest poses and frictions, each draw re-weighed at its refitted states
+(rest_refit.py), since the run-out is far from linear over a rest pose's
+spread for some wheel setups.
 """
 
 from __future__ import annotations
