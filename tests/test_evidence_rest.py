@@ -169,7 +169,7 @@ def test_rest_intervals_cover_the_truth_for_a_run_out_far_from_linear():
     """Front wheels locked, rear rolling on the striking car (the setup whose
     linearised intervals held the truth in 71 and 75 of 100 trials): noisy rest
     poses and speed, 100 seeded trials over two scenes, Monte Carlo intervals
-    with every drawn rest pose refitted (400 draws). Each vehicle's 90 % speed
+    with every drawn rest pose refitted and re-weighed (400 draws). Each vehicle's 90 % speed
     interval misses the truth Binomial(100, 0.1) times at the nominal rate;
     3 <= misses <= 19 holds with probability > 99.5 % (bounds fixed before the
     first run of this test)."""
