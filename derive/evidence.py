@@ -24,6 +24,16 @@ velocities (what an EDR's wheel speed measures). delta-V along and across a
 vehicle (`dl`, `dt`) are in its axes at its heading (forward, left), at a
 module at (a, b) (forward, left) from its centre of gravity: the change of
 velocity of that body point, ΔV + ΔW × ρ.
+
+Crush energy as an energy loss (kernel `evidence_crush_absorbed`). CRASH3's
+option ``energy: absorbed`` reads a crush energy E as the energy absorbed up
+to maximum crush: in CRASH3's one-dimensional impact of the effective masses
+along the PDOF it is the relative kinetic energy m̄ v_c²/2 at the approach,
+and with restitution e the energy lost over the whole impact is
+T_L = (1 - e)(1 + e) E (written as a product: 1 - e² loses digits as e → 1).
+Proved below twice: from the 1-D impact itself, and against the CRASH3
+kernels' own relation (derive/crash3.py): the "dissipated" delta-V of the
+energy T_L is the "absorbed" delta-V of E, for every e.
 """
 
 from __future__ import annotations
@@ -32,6 +42,7 @@ import random
 
 import sympy as sp
 
+from . import crash3 as c3
 from . import frame as f
 from . import jacobian, planar
 from .frame import (
@@ -86,6 +97,7 @@ L1, L2, dV1x, dV1y, dV2x, dV2y, dW1, dW2 = real("L1 L2 dV1x dV1y dV2x dV2y dW1 d
 s1, s2, dl1, dt1, dl2, dt2, R_em = real("s1 s2 dl1 dt1 dl2 dt2 R_em")
 ax, ay, q2, norm, direction = real("ax ay q2 norm direction")
 Gn, Gt, Wr, dVx, dVy = real("Gn Gt Wr dVx dVy")
+E_absorbed, E_lost = real("E_absorbed E_lost")
 
 STATE = (v1x, v1y, w1, v2x, v2y, w2, Px, Py, M)
 MASSES = (m1, m2, I1, I2)
@@ -291,11 +303,35 @@ def _derived_kernel() -> Kernel:
     )
 
 
+def _crush_kernel() -> Kernel:
+    """The energy lost over the impact from a crush energy absorbed up to
+    maximum crush, with restitution e (module docstring)."""
+    return Kernel(
+        name="evidence_crush_absorbed",
+        doc="Energy lost over the impact from the crush energy E absorbed up to maximum crush: (1 - e)(1 + e) E.",
+        inputs=(E_absorbed, e),
+        checks=(
+            finite_inputs((E_absorbed, e)),
+            Guard(
+                (sp.GreaterThan(E_absorbed, 0), sp.GreaterThan(e, 0), sp.LessThan(e, 1)),
+                "ENERGY_INCONSISTENT",
+            ),
+        ),
+        blocks=(
+            Block(
+                ((E_lost, (1 - e) * (1 + e) * E_absorbed),),
+                equation="T_L = (1 - e^2) E_absorbed: CRASH3's 1-D impact (Rose et al. SAE 2006-01-0908)",
+            ),
+        ),
+        outputs=(E_lost,),
+    )
+
+
 def _vector_inputs(knl: Kernel):
-    return (ax, ay) if knl.name == "evidence_vector" else STATE
+    return {"evidence_vector": (ax, ay), "evidence_crush_absorbed": (E_absorbed, e)}.get(knl.name, STATE)
 
 
-KERNELS = (_linear_kernel(), _energy_kernel(), _vector_kernel(), _derived_kernel())
+KERNELS = (_linear_kernel(), _energy_kernel(), _vector_kernel(), _derived_kernel(), _crush_kernel())
 EMITTED = tuple(
     jacobian.jacobian_kernel(k, name=k.name, wrt=_vector_inputs(k), family="evidence") for k in KERNELS
 )
@@ -453,6 +489,42 @@ def _derivatives_agree(knl: Kernel, base: Kernel, wrt, rng, points: int = 2) -> 
     return False
 
 
+def _crush_holds() -> list:
+    """evidence_crush_absorbed against the 1-D impact of two masses M1, M2
+    (approach speed v > 0, impulse m̄ v (1 + e), m̄ = M1 M2/(M1 + M2)) and
+    against CRASH3's absorbed/dissipated delta-V kernels."""
+    M1, M2, v = sp.symbols("M1 M2 v", positive=True)
+    lost = KERNELS[4].expanded(E_lost)
+
+    def loss(restitution):
+        impulse = M1 * M2 / (M1 + M2) * v * (1 + restitution)
+        u1, u2 = v - impulse / M1, impulse / M2
+        return M1 * v**2 / 2 - (M1 * u1**2 + M2 * u2**2) / 2, u2 - u1
+
+    total, separation = loss(e)
+    absorbed, _ = loss(0)
+    one_d = (
+        sp.simplify(total - lost.xreplace({E_absorbed: absorbed})) == 0
+        and sp.simplify(separation - e * v) == 0
+    )
+    kernels = {k.name: k for k in c3.KERNELS}
+    p_abs = kernels["crash3_delta_v_absorbed"].expanded(c3.P, frozenset({c3.ke1, c3.ke2}))
+    p_dis = kernels["crash3_delta_v"].expanded(c3.P, frozenset({c3.ke1, c3.ke2}))
+    same = sp.simplify(p_dis.xreplace({c3.E: lost.xreplace({E_absorbed: c3.E})}) ** 2 - p_abs**2) == 0
+    return [
+        (
+            "evidence_crush_absorbed: in the 1-D impact with restitution e (separation e times approach) "
+            "the energy lost is (1 - e^2) times the energy lost up to maximum crush (common velocity)",
+            one_d,
+        ),
+        (
+            "evidence_crush_absorbed: CRASH3's dissipated |P| of (1 - e^2) E equals its absorbed |P| of E "
+            "(crash3_delta_v, crash3_delta_v_absorbed)",
+            same,
+        ),
+    ]
+
+
 def proofs():
     """(claim, passed) for the observation equations and their Jacobians."""
     rng = random.Random(20261124)
@@ -473,6 +545,7 @@ def proofs():
             _derived_matches_forward(rng),
         )
     )
+    claims += _crush_holds()
     for knl, base in zip(EMITTED, KERNELS):
         claims.append(
             (

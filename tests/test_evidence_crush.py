@@ -126,15 +126,75 @@ def test_a_bad_crush_block_is_a_one_line_error_naming_the_field(change, field):
     assert err.value.field == field and "\n" not in str(err.value)
 
 
-def test_absorbed_energy_and_missing_profile_are_refused():
+def test_a_missing_profile_is_refused():
     t = truth(19)
     scene, _ = scene_with_crush(t, 0.4)
-    with pytest.raises(SceneError, match="crash3.energy"):
-        fit({**scene, "crash3": {"energy": "absorbed"}}, draws=0)
     del scene["evidence"][3]["crush"]
     with pytest.raises(SceneError) as err:
         fit(scene, draws=0)
     assert err.value.field == "evidence[3].value"
+
+
+def absorbed_scene(t, e: float, share: float = 0.4):
+    """Truth `t`'s crush scene with profiles whose CRASH3 energies, read as
+    absorbed up to maximum crush with restitution e, lose T_L over the impact:
+    each profile holds its share of T_L divided by (1 - e^2) (Rose et al.'s 1-D
+    impact, independent of the fit's kernels)."""
+    scene, energies = scene_with_crush(t, share)
+    for j, i in ((3, 0), (4, 1)):
+        absorbed = energies[i] / (1 - e * e)
+        scene["evidence"][j]["crush"] = profile_for(absorbed, pdof=10.0 * i)
+        scene["evidence"][j]["sd"] = 0.05 * absorbed
+    scene["crash3"] = {"energy": "absorbed", "restitution": e}
+    return scene
+
+
+@pytest.mark.parametrize("e", [0.0, 0.3])
+def test_absorbed_crush_energies_recover_the_speeds(e):
+    t = truth(19)
+    got = fit(absorbed_scene(t, e), draws=200, seed=1).to_json_dict()
+    (energy,) = [r for r in got["residuals"] if r["label"].startswith("energy_loss.total")]
+    assert f"absorbed energies x (1 - e^2), e = {e:g}" in energy["label"]
+    assert energy["value"] == pytest.approx(t["ref"]["TL"], rel=1e-6)
+    for i in (0, 1):
+        lo, hi = got["vehicles"][i]["speed_interval"]
+        assert lo <= t["speeds"][i] <= hi
+        assert got["vehicles"][i]["speed"] == pytest.approx(t["speeds"][i], rel=1e-4)
+
+
+def test_the_absorbed_reading_is_the_crash3_codes_own():
+    """The energy loss the fit reads from absorbed crush energies is the energy
+    that CRASH3 (impactsym.crash3, its own kernels) would need, read as
+    dissipated, to give the delta-V it gives the same crush read as absorbed:
+    delta-V grows as sqrt(E), so T_L = sum E x (dV_absorbed / dV_dissipated)^2."""
+    e = 0.3
+    t = truth(19)
+    scene = absorbed_scene(t, e)
+    (energy,) = [
+        r for r in fit(scene, draws=0).to_json_dict()["residuals"] if r["label"].startswith("energy")
+    ]
+    vehicles = [
+        {k: v for k, v in vehicle.items() if k != "heading"} | {"crush": scene["evidence"][3 + i]["crush"]}
+        for i, vehicle in enumerate(scene["vehicles"])
+    ]
+
+    def crash(mode):
+        options = {"energy": mode, "restitution": e}
+        return crash3({"units": "SI", "impact": scene["impact"], "vehicles": vehicles, "crash3": options})
+
+    absorbed, dissipated = crash("absorbed"), crash("dissipated")
+    ratio = absorbed.vehicles[0].delta_v_magnitude / dissipated.vehicles[0].delta_v_magnitude
+    assert energy["value"] == pytest.approx(dissipated.energy_total * ratio**2, rel=1e-9)
+    assert energy["value"] < dissipated.energy_total
+
+
+def test_absorbed_with_restitution_one_is_refused():
+    t = truth(19)
+    scene = absorbed_scene(t, 0.3)
+    scene["crash3"]["restitution"] = 1.0
+    with pytest.raises(SceneError) as err:
+        fit(scene, draws=0)
+    assert err.value.field == "crash3.restitution" and "\n" not in str(err.value)
 
 
 def test_an_unused_vehicle_crush_block_is_named_in_the_warnings():
@@ -144,3 +204,21 @@ def test_an_unused_vehicle_crush_block_is_named_in_the_warnings():
     got = fit(scene, draws=0).to_json_dict()
     assert any(w.startswith("vehicles[1].crush is not used") for w in got["warnings"])
     assert not any(w.startswith("vehicles[0].crush is not used") for w in got["warnings"])
+
+
+def test_a_crash3_restitution_the_fit_rules_out_is_named():
+    """The absorbed reading uses crash3.restitution, not the fitted e: when the
+    fitted e's 90 % interval excludes it the answer says the two readings
+    disagree; at the truth's own e it does not."""
+    t = truth(19)
+    said = "outside the fitted restitution's 90 % interval"
+    near = fit(absorbed_scene(t, t["row"]["e"]), draws=200, seed=1)
+    assert near.estimates["restitution"].determined
+    assert not any(said in w for w in near.warnings)
+    far = fit(absorbed_scene(t, 0.9), draws=200, seed=1)
+    low, high = far.estimates["restitution"].interval
+    assert not low <= 0.9 <= high
+    assert any(
+        w.startswith("the crush energies were read as absorbed with crash3.restitution 0.9")
+        for w in far.warnings
+    )

@@ -43,10 +43,10 @@ from ..scene.casefile import (
     vehicle_state,
 )
 from ..scene.reader import read_body
-from .crush_item import crash3_mode, unused_crush, with_profile_energy
+from .crush_item import as_energy_lost, crash3_restitution, unused_crush, with_profile_energy
 from .edr_item import edr_observations
 from .items import EVIDENCE_KEYS, Observation, crush_energies, read_item
-from .rest_item import RUNOUT_VEHICLE_KEYS, rest_observations
+from .rest_item import RUNOUT_VEHICLE_KEYS, RestEvidence, frictions, read_rest, rest_evidence
 
 STATE = ("v1x", "v1y", "w1", "v2x", "v2y", "w2", "Px", "Py", "M")
 #: Impact laws a fit can read its answer in, besides Brach's (e, mu): impactsym.laws.
@@ -72,6 +72,8 @@ class FitCase:
     warnings: list[str] = field(default_factory=list)
     normal: tuple | None = None  # the normal angle's distribution: (kind, params [deg], offset [deg])
     law: str | None = None  # "model": "kudlich_slibar": the fit is also read as that law (FIT_LAWS)
+    rest: RestEvidence | None = None  # the rest items, whitened together (rest_item.py)
+    crush_restitution: float | None = None  # crash3.restitution of crush energies read as "absorbed"
 
 
 def read_case(source: Mapping | str | Path) -> FitCase:
@@ -141,18 +143,26 @@ def read_case(source: Mapping | str | Path) -> FitCase:
     raw = data.get("evidence")
     if not isinstance(raw, list) or not raw:
         raise SceneError(f"must be a non-empty list of evidence items, got {show_value(raw)}", "evidence")
-    observations = []
+    observations, rests = [], []  # rests: (position in observations, RestFit)
     for k, item in enumerate(raw):
         if isinstance(item, Mapping) and "edr" in item:
             check_keys(item, EVIDENCE_KEYS, f"evidence[{k}]")
             observations += edr_observations(item, k, units, names, fixed, source, warnings)
         elif isinstance(item, Mapping) and item.get("quantity") == "rest":
             check_keys(item, EVIDENCE_KEYS, f"evidence[{k}]")
-            observations += rest_observations(item, k, data, (units, names, fixed, params), warnings)
+            rests.append(
+                (len(observations), read_rest(item, k, data, (units, names, fixed, params), warnings))
+            )
         else:
             item = with_profile_energy(item, k, data, names, fixed, warnings)
             observations += read_item(item, k, units, names, fixed)
-    observations = crush_energies(observations, fixed, crash3_mode(data))
+    rest = _insert_rest(observations, rests, data)
+    absorbed = crash3_restitution(data)
+    if not any(o.label.endswith(".crush_energy") for o in observations):
+        absorbed = None  # no crush energy read with it
+    observations = crush_energies(as_energy_lost(observations, absorbed), fixed, absorbed)
+    if rest is not None:
+        rest.rows = [j for j, o in enumerate(observations) if o.how[0] == "combination"]
     warnings += unused_crush(data, names)
     yaw_observed = {o.how[1] for o in observations if o.how[0] == "state"}
     for i in range(2):
@@ -176,7 +186,21 @@ def read_case(source: Mapping | str | Path) -> FitCase:
         warnings,
         normal,
         model if model in FIT_LAWS else None,
+        rest,
+        absorbed,
     )
+
+
+def _insert_rest(observations: list, rests: list, data) -> RestEvidence | None:
+    """Put the rest items' joint observations (rest_item.rest_evidence) where
+    each item stands in the evidence list; the record of them, or None."""
+    if not rests:
+        return None
+    items = [r for _, r in rests]
+    rows, evidence = rest_evidence(items, frictions(data, items))
+    for j, (position, _) in reversed(list(enumerate(rests))):
+        observations[position:position] = rows[3 * j : 3 * j + 3]
+    return evidence
 
 
 def _unit(index: int) -> np.ndarray:

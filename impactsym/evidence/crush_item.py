@@ -6,10 +6,16 @@ The profile is the item's ``crush`` object or, when the item has neither
 scene). The energy is CRASH3's crush energy with its oblique correction
 (``crash3.correction`` of the scene's top-level ``"crash3"`` options), in the
 scene's energy unit; the item's ``sd`` is that energy's standard deviation.
-Only CRASH3's energy "dissipated" is an observation of the fit (the energy
-lost over the impact, :func:`.items.crush_energies`); "absorbed" would need
-the energy loss as a function of the absorbed energy and the restitution,
-which derive/ does not emit for the fit, so it is refused.
+
+What the energy observes follows the scene's ``crash3.energy`` option, as in
+``impactsym crash3``: "dissipated" (default) is the energy lost over the
+impact; "absorbed" is the energy absorbed up to maximum crush, and the energy
+lost is then (1 - e)(1 + e) times it (kernel ``evidence_crush_absorbed``,
+derived and proved in derive/evidence.py; its sd scales by the same factor),
+e the scene's ``crash3.restitution``: the restitution of CRASH3's 1-D impact
+along the PDOF that the energy was read with, not the fit's e (docs/conventions.md,
+"Reconstruction from evidence"). Either way the crush energies are then summed
+into an observation of T_L (:func:`.items.crush_energies`).
 """
 
 from __future__ import annotations
@@ -17,14 +23,45 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from ..codes import describe_status
 from ..crash3 import crash3, crash3_options
 from ..errors import SceneError
-from .items import vehicle_index
+from ._door import evaluate
+from .items import Observation, vehicle_index
 
 
-def crash3_mode(data: Mapping) -> str:
-    """The scene's CRASH3 energy mode, checked (``crash3`` options as crash3 reads them)."""
-    return crash3_options(data).energy
+def crash3_restitution(data: Mapping) -> float | None:
+    """The scene's CRASH3 restitution when its crush energies are "absorbed"
+    (``crash3`` options as crash3 reads them, checked); None when "dissipated"."""
+    options = crash3_options(data)
+    return options.restitution if options.energy == "absorbed" else None
+
+
+def as_energy_lost(observations: list[Observation], restitution: float | None) -> list[Observation]:
+    """Crush energies absorbed up to maximum crush as the energies lost over
+    the impact, (1 - e^2) E with sd (1 - e^2) sd (module docstring); the list
+    unchanged when `restitution` is None (energies dissipated)."""
+    if restitution is None:
+        return observations
+    out = []
+    for obs in observations:
+        if obs.label.endswith(".crush_energy"):
+            lost = evaluate("evidence_crush_absorbed", {"E_absorbed": obs.value, "e": restitution})
+            if lost["status"] != 0:
+                raise SceneError(
+                    f"the crush energy absorbed does not give an energy loss: {describe_status(lost['status'])}",
+                    f"evidence[{obs.evidence}].value",
+                )
+            sd = lost["d_E_lost__d_E_absorbed"] * obs.sd
+            if not sd > 0:
+                raise SceneError(
+                    "with the crush energy absorbed and restitution 1 the energy loss is 0 whatever the crush: "
+                    "the crush energy observes nothing (give a restitution below 1)",
+                    "crash3.restitution",
+                )
+            obs = Observation(obs.evidence, obs.label, lost["E_lost"], sd, obs.how)
+        out.append(obs)
+    return out
 
 
 def profile_energy(item: Mapping, i: int, k: int, data: Mapping, warnings: list) -> float:

@@ -24,6 +24,7 @@ from ..result import json_number
 from .case import STATE, FitCase, read_case
 from .law import law_reading
 from .model import Model, energy_loss
+from .rest_item import linearity_warnings
 from .solve import Z90, Identifiability, fit_case
 
 #: Flag bits of evidence_derived (conventions.md) and the quantities each needs determined.
@@ -211,8 +212,9 @@ def fit(scene: Mapping | str | Path, draws: int = 400, seed: int = 0, method: st
     at = quantities(model, x_hat)
     derived = at.pop("_derived", None)
     drawn = _drawn(model, samples, _normal_draws(case, len(samples), seed))
+    gaussian = info["intervals"].startswith("gaussian")
     estimates = {
-        p: _estimate(p, v, g, aff, ident, info["linear"], drawn.get(p), derived, case.unknowns)
+        p: _estimate(p, v, g, aff, ident, gaussian, drawn.get(p), derived, case.unknowns)
         for p, (v, g, aff) in at.items()
     }
     if not case.has_normal:
@@ -229,6 +231,13 @@ def fit(scene: Mapping | str | Path, draws: int = 400, seed: int = 0, method: st
     residuals, worst = _residuals(case, model, y)
     flags = _flags(derived, estimates)
     warnings = _warnings(case, len(model.values), ident.rank, estimates, derived, flags, worst)
+    if case.rest is not None and not samples:
+        warnings += linearity_warnings(case.rest)
+    if info.get("rest_refits_failed"):
+        warnings.append(
+            f"{info['rest_refits_failed']} of {draws} Monte Carlo draws were dropped: no separation state "
+            "reaches their drawn rest pose"
+        )
     if not info["converged"]:
         warnings.append(f"Gauss-Newton stopped after {info['iterations']} iterations without converging")
     return FitResult(
@@ -268,6 +277,15 @@ def _warnings(case: FitCase, observations: int, rank: int, estimates, derived, f
         )
     elif worst is not None:
         warnings.append("the fit reproduces every item: no evidence checks another")
+    restitution = estimates.get("restitution")
+    if case.crush_restitution is not None and restitution is not None and restitution.interval:
+        low, high = restitution.interval
+        e = case.crush_restitution
+        if (low is not None and e < low) or (high is not None and e > high):
+            warnings.append(
+                f"the crush energies were read as absorbed with crash3.restitution {e:g}, outside the fitted "
+                "restitution's 90 % interval: the two readings of the impact disagree"
+            )
     missing = [p for p, e in estimates.items() if not e.determined and p in case.unknowns]
     if missing:
         warnings.append(f"the evidence does not determine {', '.join(missing)} (see identifiability)")
@@ -309,14 +327,14 @@ def _drawn(model: Model, samples, gammas=None) -> dict:
 
 
 def _estimate(
-    path, value, grad, affine, ident: Identifiability, linear, drawn, derived, unknowns
+    path, value, grad, affine, ident: Identifiability, gaussian, drawn, derived, unknowns
 ) -> Estimate:
     if not math.isfinite(value):
         why = describe_status(derived["status"]) if derived is not None and derived["status"] else "undefined"
         return Estimate(None, determined=False, why=f"not defined at the estimate: {why}")
     if not ident.determined(grad):
         return Estimate(None, determined=False, why=_why(ident, grad, unknowns))
-    if affine and linear:
+    if affine and gaussian:
         sd = float(math.sqrt(max(grad @ ident.cov @ grad, 0.0)))
         return Estimate(float(value), sd, (value - Z90 * sd, value + Z90 * sd))
     if drawn is None or not np.isfinite(drawn).any():

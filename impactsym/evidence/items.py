@@ -172,22 +172,20 @@ def read_item(item: Any, k: int, units: str, names, fixed) -> list[Observation]:
     return [Observation(k, label, value, sd, how, angle=dimension == "angle")]
 
 
-def crush_energies(observations: list[Observation], fixed, mode: str = "dissipated") -> list[Observation]:
-    """CRASH3's energy "dissipated" (conventions.md): the crush energies of the
-    vehicles together are the energy loss. Given for every moving vehicle (one
-    against a fixed barrier) their sum is an observation of T_L (the sds in
-    quadrature); given for one of two moving vehicles it is a one-sided bound,
-    T_L at least that energy (the other's crush energy is ≥ 0). `mode` is the
-    scene's ``crash3.energy``: "absorbed" is refused (no derived observation)."""
+def crush_energies(
+    observations: list[Observation], fixed, absorbed: float | None = None
+) -> list[Observation]:
+    """The crush energies of the vehicles together are the energy loss (each
+    already an energy lost over the impact: CRASH3's "dissipated", or its
+    "absorbed" times (1 - e^2), crush_item.as_energy_lost). Given for every
+    moving vehicle (one against a fixed barrier) their sum is an observation of
+    T_L (the sds in quadrature); given for one of two moving vehicles it is a
+    one-sided bound, T_L at least that energy (the other's crush energy is
+    >= 0). `absorbed` is the restitution the energies were read with, for the
+    label."""
     crush = [o for o in observations if o.label.endswith(".crush_energy")]
     if not crush:
         return observations
-    if mode != "dissipated":
-        raise SceneError(
-            'a crush_energy item is read as CRASH3\'s energy "dissipated" only (the energy loss); '
-            '"absorbed" needs a derived observation the fit does not have',
-            "crash3.energy",
-        )
     moving = [i for i in (0, 1) if not fixed[i]]
     crushed = sorted(int(o.label[len("vehicles[")]) for o in crush)
     if len(set(crushed)) != len(crushed):
@@ -196,11 +194,16 @@ def crush_energies(observations: list[Observation], fixed, mode: str = "dissipat
             f"evidence[{crush[-1].evidence}].vehicle",
         )
     both = crushed == moving
-    total = Observation(
-        crush[0].evidence,
+    label = (
         ("energy_loss.total" if len(moving) == 1 else "energy_loss.total (sum of the crush energies)")
         if both
-        else f"energy_loss.total (at least vehicles[{crushed[0]}].crush_energy)",
+        else f"energy_loss.total (at least vehicles[{crushed[0]}].crush_energy)"
+    )
+    if absorbed is not None:
+        label += f" [absorbed energies x (1 - e^2), e = {absorbed:g}]"
+    total = Observation(
+        crush[0].evidence,
+        label,
         sum(o.value for o in crush),
         math.sqrt(sum(o.sd**2 for o in crush)),
         ("energy",),

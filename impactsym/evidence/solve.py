@@ -20,7 +20,10 @@ constraint R_em = 0, removed by parametrising x = xp + N u.
 - Intervals (90 %): affine quantities of a linear problem from the Gaussian
   covariance (±1.645 σ, exact); everything else by Monte Carlo over the
   evidence (each value redrawn from its normal, refitted; a linear problem
-  draws x from its Gaussian directly): 5th and 95th percentiles.
+  without rest poses draws x from its Gaussian directly; rest poses and
+  their frictions are redrawn and refitted through the run-out,
+  rest_refit.py, since their observations are a linearisation): 5th and
+  95th percentiles.
 """
 
 from __future__ import annotations
@@ -32,6 +35,7 @@ import numpy as np
 from ..errors import SceneError
 from .case import STATE, FitCase
 from .model import Model
+from .rest_refit import draw_whitened
 
 RANK_TOL = 1e-9
 DETERMINED_TOL = 1e-6
@@ -228,23 +232,64 @@ class Identifiability:
 
 
 def draw_fits(model: Model, xp, N, u_hat, ident: Identifiability, linear: bool, draws: int, seed: int):
-    """Monte Carlo over the evidence: the unknowns x of each accepted draw."""
+    """Monte Carlo over the evidence: (the unknowns x of each accepted draw,
+    rest-pose refits that failed). A linear problem without rest poses draws x
+    from its Gaussian; otherwise each draw redraws every observation value
+    (rest poses refitted through the run-out, rest_refit.py) and refits."""
     rng = np.random.default_rng(seed)
-    out = []
-    if linear:
+    rest = model.case.rest
+    if linear and rest is None:
         cov = ident.cov
         w, v = np.linalg.eigh((cov + cov.T) / 2)
         root = v * np.sqrt(np.clip(w, 0, None))
         x_hat = xp + N @ u_hat
-        return [x_hat + root @ rng.standard_normal(len(w)) for _ in range(draws)]
-    for _ in range(draws):
-        values = model.values + model.sd * rng.standard_normal(len(model.sd))
-        try:
-            u, _ = gauss_newton(model, xp, N, u_hat, values=values, max_iter=20)
-        except SceneError:
-            continue
-        out.append(xp + N @ u)
-    return out
+        return [x_hat + root @ rng.standard_normal(len(w)) for _ in range(draws)], 0
+    values = model.values + model.sd * rng.standard_normal((draws, len(model.sd)))
+    whitened = draw_whitened(rest, rng, draws) if rest is not None else [None] * draws
+    saved = model.a.copy(), model.B.copy(), model.sd.copy()
+    outputs = _outputs(model, rest.outputs) if rest is not None else None
+    out, failed = [], 0
+    try:
+        for drawn, rest_rows in zip(values, whitened):
+            if rest is not None:
+                if rest_rows is None:
+                    failed += 1
+                    continue
+                _reweigh(model, rest.rows, outputs, rest_rows, drawn)
+            x = _refit(model, xp, N, u_hat, linear, drawn)
+            if x is not None:
+                out.append(x)
+    finally:
+        model.a, model.B, model.sd = saved
+    return out, failed
+
+
+def _outputs(model: Model, names) -> tuple[np.ndarray, np.ndarray]:
+    """(a, B): evidence_linear outputs `names` as a + B x in the unknowns."""
+    pairs = [model.affine(name) for name in names]
+    case = model.case
+    return np.array([a + b @ case.z0 for a, b in pairs]), np.array([b @ case.T for _, b in pairs])
+
+
+def _reweigh(model: Model, rows, outputs, rest_rows, drawn) -> None:
+    """Set the rest observations' rows of `model` (offsets, Jacobian rows,
+    sds) and their values in `drawn` to one Monte Carlo draw's whitening
+    (rest_refit.draw_whitened); `outputs` = (a, B) of the stacked states."""
+    unit_lower, sd, states = rest_rows
+    a, B = outputs
+    model.a[rows], model.B[rows], model.sd[rows] = unit_lower @ a, unit_lower @ B, sd
+    drawn[rows] = unit_lower @ states
+
+
+def _refit(model: Model, xp, N, u_hat, linear: bool, values):
+    """The unknowns x fitted to one draw's `values` (None if Gauss–Newton fails)."""
+    if linear:
+        return xp + N @ linear_solve(model, xp, N, values)
+    try:
+        u, _ = gauss_newton(model, xp, N, u_hat, values=values, max_iter=20)
+    except SceneError:
+        return None
+    return xp + N @ u
 
 
 def fit_case(case: FitCase, draws: int = 400, seed: int = 0, method: str = "auto"):
@@ -260,14 +305,26 @@ def fit_case(case: FitCase, draws: int = 400, seed: int = 0, method: str = "auto
     x_hat = xp + N @ u_hat
     y, J = model.predict(x_hat)
     ident = Identifiability(model.whitened(y, J)[1], N)
-    samples = draw_fits(model, xp, N, u_hat, ident, linear, draws, seed) if draws else []
+    samples, failed = draw_fits(model, xp, N, u_hat, ident, linear, draws, seed) if draws else ([], 0)
     info = {
         "linear": linear,
+        "intervals": _intervals(linear, case, draws),
         "iterations": iterations,
         "converged": iterations < MAX_ITERATIONS,
         "method": "closed form" if iterations == 0 else "gauss-newton",
     }
+    if case.rest is not None and draws:
+        info["rest_refits_failed"] = failed
     return model, x_hat, y, ident, samples, info
+
+
+def _intervals(linear: bool, case: FitCase, draws: int) -> str:
+    """How the answer's 90 % intervals are found (``method.intervals``)."""
+    if linear and (case.rest is None or not draws):
+        return "gaussian" + (" (rest poses linearised)" if case.rest is not None else "")
+    if not draws:
+        return "linearised (no draws)"
+    return "monte carlo over the evidence" + (", rest poses refitted" if case.rest is not None else "")
 
 
 __all__ = ["STATE", "fit_case"]
