@@ -99,6 +99,10 @@ W_B_EMBEDDED = (3.7810903145819369e-01, -9.6042292212423178e-02, 0.5, 2.17933260
 # times the Jacobian's bound on |lambda| falls below W_LEAVE.
 W_ENTER = 2.0
 W_LEAVE = 2.0
+# A hand-over refused at once (h |lambda| bound below W_LEAVE: the explicit step
+# is as long as the stiff one would be) is not tried again for W_WAIT steps
+# (each try costs a Jacobian: a fifth of a step).
+W_WAIT = 10
 
 # Row status codes of runout_batch (0 solved). 1 and 2 mean what they mean in
 # solve_batch (derive/codes.py); 20-23 are the run-out's own.
@@ -510,6 +514,7 @@ def _w_constants() -> list[str]:
         f"W_E = np.array({[b - e for b, e in zip(W_B, W_B_EMBEDDED)]!r})  # B - B_EMBEDDED",
         f"W_ENTER = {W_ENTER!r}  # h |lambda| that hands a step to ROS34PW2",
         f"W_LEAVE = {W_LEAVE!r}  # h |lambda| bound below which Dormand-Prince takes over again",
+        f"W_WAIT = {W_WAIT!r}  # Dormand-Prince steps before a refused hand-over is tried again",
     ]
 
 
@@ -723,8 +728,10 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
     ROS34PW2 step whose bound h |lambda| (_stiffness of the Jacobian) is below
     W_LEAVE hands back. The local error of the state (x, y, psi, vx,
     vy, w) is kept below `tol` (absolute, SI) per step; the distance and the
-    sensitivities ride on the same steps. Accepted points (t, x, y, psi) go to
-    `path` while it has room. Returns (t, status, steps, points)."""
+    sensitivities ride on the same steps. The step in which the vehicle stops
+    is cut back to where _speed falls through V_STOP (_to_stop). Accepted
+    points (t, x, y, psi) go to `path` while it has room. Returns (t, status,
+    steps, points)."""
     n = y.shape[0]
     k1 = np.empty(n)
     k2 = np.empty(n)
@@ -735,6 +742,8 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
     k7 = np.empty(n)
     z = np.empty(n)
     z6 = np.empty(6)
+    y0 = np.empty(n)
+    f0 = np.empty(n)
     K = np.empty((4, n))
     J = np.empty((3, 4))
     t = 0.0
@@ -742,6 +751,8 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
     steps = 0
     points = 0
     stiff = False
+    taken = False  # the last step was a ROS34PW2 step
+    wait = 0  # Dormand-Prince steps before the stiffness is looked at again
     fresh = False  # J holds the Jacobian at y
     if path.shape[0] > 0:
         path[0, 0], path[0, 1], path[0, 2], path[0, 3] = 0.0, y[0], y[1], y[2]
@@ -757,14 +768,19 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
             if not fresh:
                 _jac(y, P, W, J)
                 fresh = True
-            stiff = h*_stiffness(J) >= W_LEAVE
+            stiff = h*_stiffness(J, P[5]) >= W_LEAVE
+            if not (stiff or taken):  # handed straight back: look again W_WAIT steps later
+                wait = W_WAIT
         if stiff:
+            taken = True
             err = _wstep__SUFFIX__(y, P, W, h, k1, J, K, z, k2, k3)/tol
             if not (err <= 1.0):  # rejected (NaN included)
                 h *= 0.1 if not math.isfinite(err) else max(0.2, 0.9*err**(-1.0/3.0))
                 continue
             t += h
             for i in range(n):
+                y0[i] = y[i]
+                f0[i] = k1[i]
                 y[i] = k3[i]
             _rhs__SUFFIX__(y, P, W, k1)
             fresh = False
@@ -807,17 +823,24 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
             for i in range(6):
                 num += (k7[i] - k6[i])**2
                 den += (z[i] - z6[i])**2
-            stiff = h*h*num > W_ENTER*W_ENTER*den
+            stiff = wait == 0 and h*h*num > W_ENTER*W_ENTER*den
+            wait = max(wait - 1, 0)
+            taken = False
             t += h
             for i in range(n):
+                y0[i] = y[i]
+                f0[i] = k1[i]
                 y[i] = z[i]
                 k1[i] = k7[i]
             fresh = False
             grow = 5.0 if err < 1e-10 else min(5.0, 0.9*err**-0.2)
+        stopped = _speed(y, P) < V_STOP
+        if stopped:
+            t = _to_stop(y0, f0, y, k1, t, h, P)
         if points < path.shape[0]:
             path[points, 0], path[points, 1], path[points, 2], path[points, 3] = t, y[0], y[1], y[2]
             points += 1
-        if _speed(y, P) < V_STOP:
+        if stopped:
             return t, STATUS_OK, steps, points
         h = min(h*grow, H_MAX)
 
@@ -888,15 +911,50 @@ def _jac(y, P, W, J):
 
 
 @__JIT__
-def _stiffness(J):
-    """A bound on |lambda| of the state's Jacobian: the largest row sum of
-    |d(ax, ay, alpha)/d(vx, vy, w)| (Gershgorin: the damping) plus the square
-    root of the largest |d(ax, ay, alpha)/d psi| (the heading's stiffness)."""
+def _to_stop(y0, f0, y1, f1, t1, h, P):
+    """Cut the last step (y0, f0 at t1 - h; y1, f1 at t1) back to where the
+    speed |v| + |w| R_max falls through V_STOP (as the reference's stop event
+    does): bisection on the cubic Hermite interpolant of the step, accurate to
+    O(h^4); writes the state there into y1 and returns its time. Without it
+    the run-out would end wherever the step that crossed V_STOP ended, which
+    a long L-stable step puts up to V_STOP h further on."""
+    lo = 0.0
+    hi = 1.0
+    for _ in range(40):
+        mid = 0.5*(lo + hi)
+        a, b, c, d = _hermite(mid)
+        vx = a*y0[3] + b*h*f0[3] + c*y1[3] + d*h*f1[3]
+        vy = a*y0[4] + b*h*f0[4] + c*y1[4] + d*h*f1[4]
+        w = a*y0[5] + b*h*f0[5] + c*y1[5] + d*h*f1[5]
+        if math.sqrt(vx*vx + vy*vy) + abs(w)*P[5] < V_STOP:
+            hi = mid
+        else:
+            lo = mid
+    a, b, c, d = _hermite(hi)
+    for i in range(y1.shape[0]):
+        y1[i] = a*y0[i] + b*h*f0[i] + c*y1[i] + d*h*f1[i]
+    return t1 - h + hi*h
+
+
+@__JIT__
+def _hermite(s):
+    """Weights of y0, h f0, y1, h f1 in the cubic Hermite interpolant at s in [0, 1]."""
+    return 2.0*s**3 - 3.0*s*s + 1.0, s**3 - 2.0*s*s + s, 3.0*s*s - 2.0*s**3, s**3 - s*s
+
+
+@__JIT__
+def _stiffness(J, R):
+    """A bound on |lambda| of the state's Jacobian: Gershgorin's largest row sum
+    of |d(ax, ay, alpha)/d(vx, vy, w)| (the damping) plus the square root of the
+    largest |d(ax, ay, alpha)/d psi| (the heading's stiffness), with the yaw
+    rows and columns scaled by R (R_max; a similarity, so the eigenvalues stay
+    and the bound is tighter: the entries are then all in 1/s or 1/s^2)."""
     damp = 0.0
     turn = 0.0
     for r in range(3):
-        damp = max(damp, abs(J[r, 1]) + abs(J[r, 2]) + abs(J[r, 3]))
-        turn = max(turn, abs(J[r, 0]))
+        row = 1.0 if r < 2 else R
+        damp = max(damp, row*(abs(J[r, 1]) + abs(J[r, 2]) + abs(J[r, 3])/R))
+        turn = max(turn, row*abs(J[r, 0])/R)
     return damp + math.sqrt(turn)
 
 
