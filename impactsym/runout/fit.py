@@ -53,7 +53,6 @@ YAW_SCALES = (1.0, 0.5, 0.0, -0.5, -1.0, 1.5)
 UNIQUE_STARTS = 3
 DIVERSE_YAW = 0.3  # rad/s: extra starts differ at least this much in yaw rate
 RESCUE_STARTS = 4  # further scanned starts tried when no start converged
-RESCUE_BUDGET = 20  # run-outs per stage of Newton from a start after the first
 UNIQUE_BUDGET = 12  # run-outs per extra start
 LOOSE_TOL = 1e-5  # integrator tolerance of the scan (forward runs only)
 # Newton's first stage: with the Dormand-Prince-only integrator, 1e-5 and 1e-6
@@ -288,7 +287,7 @@ def fit_rest(vehicle: RunoutVehicle, tol: float | None = None, check_unique: boo
     first = None
     for i, start in enumerate([starts[0], *diverse, *rescue]):
         if not found:  # Newton to the full tolerances until a start converges
-            f = newton(vehicle, start, tol, MAX_ITERATIONS if i == 0 else RESCUE_BUDGET)
+            f = newton(vehicle, start, tol)
             first = first or f
             if f.converged:
                 found.append(f)
