@@ -499,14 +499,34 @@ def _constants() -> list[str]:
     ] + [f"STATUS_{k} = {v!r}" for k, v in STATUS.items()]
 
 
-def _w_constants() -> list[str]:
-    """The ROS34PW2 tables as numba-frozen arrays (numba folds global arrays into the code)."""
+# Dormand-Prince 5(4) (Dormand & Prince 1980): stage rows DP_A (the seventh is
+# the fifth-order solution, FSAL), error weights DP_E = b5 - b4.
+DP_A = (
+    (),
+    ("1/5",),
+    ("3/40", "9/40"),
+    ("44/45", "-56/15", "32/9"),
+    ("19372/6561", "-25360/2187", "64448/6561", "-212/729"),
+    ("9017/3168", "-355/33", "46732/5247", "49/176", "-5103/18656"),
+    ("35/384", "0", "500/1113", "125/192", "-2187/6784", "11/84"),
+)
+DP_E = ("71/57600", "0", "-71/16695", "71/1920", "-17253/339200", "22/525", "-1/40")
 
-    def table(rows):
-        full = [list(r) + [0.0] * (4 - len(r)) for r in rows]
+
+def _w_constants() -> list[str]:
+    """The Dormand-Prince and ROS34PW2 tables as numba-frozen arrays (numba folds global arrays into the code)."""
+
+    def table(rows, width=4):
+        full = [list(r) + [0.0] * (width - len(r)) for r in rows]
         return "np.array([" + ", ".join("[" + ", ".join(repr(x) for x in r) + "]" for r in full) + "])"
 
+    def table7(rows):
+        return table(rows, 7)
+
+    dp = [[float(sp.Rational(x)) for x in r] for r in DP_A]
     return [
+        f"DP_A = {table7(dp)}",
+        f"DP_E = np.array({[float(sp.Rational(x)) for x in DP_E]!r})",
         f"W_GAMMA = {W_GAMMA!r}",
         f"W_ALPHA = {table(W_ALPHA)}",
         f"W_GAMMAS = {table(W_GAMMAS)}",
@@ -721,25 +741,21 @@ INTEGRATE_TEMPLATE = '''@__JIT__
 def _integrate__SUFFIX__(y, P, W, tol, path):
     """Adaptive integration from t = 0 until the vehicle stops (_speed < V_STOP),
     in place on y. Non-stiff steps: Dormand-Prince 5(4) (FSAL, local
-    extrapolation). Stiff steps (a wheel near stick, where a smoothed sign is a
-    damper of slope mu N/EPS): the L-stable Rosenbrock-W method ROS34PW2
-    (_wstep). A Dormand-Prince step whose estimate h |lambda| (Hairer's, from
-    its last two stages) exceeds W_ENTER hands the next step to ROS34PW2; a
-    ROS34PW2 step whose h |lambda| (_stiffness, from the Jacobian) is below
-    W_LEAVE hands back. The local error of the state (x, y, psi, vx,
-    vy, w) is kept below `tol` (absolute, SI) per step; the distance and the
-    sensitivities ride on the same steps. The step in which the vehicle stops
-    is cut back to where _speed falls through V_STOP (_to_stop). Accepted
-    points (t, x, y, psi) go to `path` while it has room. Returns (t, status,
-    steps, points)."""
+    extrapolation; tableau DP_A, error weights DP_E). Stiff steps (a wheel near
+    stick, where a smoothed sign is a damper of slope mu N/EPS): the L-stable
+    Rosenbrock-W method ROS34PW2 (_wstep). A Dormand-Prince step whose estimate
+    h |lambda| (Hairer's, from its last two stages) exceeds W_ENTER hands the
+    next step to ROS34PW2; a ROS34PW2 step whose h |lambda| (_stiffness, from
+    the Jacobian) is below W_LEAVE hands back. The local error of the state
+    (x, y, psi, vx, vy, w) is kept below `tol` (absolute, SI) per step; the
+    distance and the sensitivities ride on the same steps. The step in which
+    the vehicle stops is cut back to where _speed falls through V_STOP
+    (_to_stop). Accepted points (t, x, y, psi) go to `path` while it has room.
+    Returns (t, status, steps, points). (The stages are a loop with one call of
+    the right-hand side, not written out: numba inlines every call site, and
+    seven of them tripled the compile time of first use.)"""
     n = y.shape[0]
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    k5 = np.empty(n)
-    k6 = np.empty(n)
-    k7 = np.empty(n)
+    k = np.empty((7, n))
     z = np.empty(n)
     z6 = np.empty(6)
     y0 = np.empty(n)
@@ -759,7 +775,7 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
         points = 1
     if _speed(y, P) < V_STOP:
         return t, STATUS_OK, steps, points
-    _rhs__SUFFIX__(y, P, W, k1)
+    _rhs__SUFFIX__(y, P, W, k[0])
     while True:
         if steps >= MAX_STEPS or t >= T_MAX:
             return t, STATUS_RUNOUT_NOT_STOPPED, steps, points
@@ -773,47 +789,30 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
                 wait = W_WAIT
         if stiff:
             taken = True
-            err = _wstep__SUFFIX__(y, P, W, h, k1, J, K, z, k2, k3)/tol
+            err = _wstep__SUFFIX__(y, P, W, h, k[0], J, K, z, k[1], k[2])/tol
             if not (err <= 1.0):  # rejected (NaN included)
                 h *= 0.1 if not math.isfinite(err) else max(0.2, 0.9*err**(-1.0/3.0))
                 continue
-            t += h
             for i in range(n):
-                y0[i] = y[i]
-                f0[i] = k1[i]
-                y[i] = k3[i]
-            _rhs__SUFFIX__(y, P, W, k1)
-            fresh = False
+                z[i] = k[2, i]
             grow = 5.0 if err < 1e-10 else min(5.0, 0.9*err**(-1.0/3.0))
         else:
-            for i in range(n):
-                z[i] = y[i] + h*(0.2*k1[i])
-            _rhs__SUFFIX__(z, P, W, k2)
-            for i in range(n):
-                z[i] = y[i] + h*(0.075*k1[i] + 0.225*k2[i])
-            _rhs__SUFFIX__(z, P, W, k3)
-            for i in range(n):
-                z[i] = y[i] + h*((44.0/45.0)*k1[i] - (56.0/15.0)*k2[i] + (32.0/9.0)*k3[i])
-            _rhs__SUFFIX__(z, P, W, k4)
-            for i in range(n):
-                z[i] = y[i] + h*((19372.0/6561.0)*k1[i] - (25360.0/2187.0)*k2[i] + (64448.0/6561.0)*k3[i]
-                                 - (212.0/729.0)*k4[i])
-            _rhs__SUFFIX__(z, P, W, k5)
-            for i in range(n):
-                z[i] = y[i] + h*((9017.0/3168.0)*k1[i] - (355.0/33.0)*k2[i] + (46732.0/5247.0)*k3[i]
-                                 + (49.0/176.0)*k4[i] - (5103.0/18656.0)*k5[i])
-            for i in range(6):
-                z6[i] = z[i]
-            _rhs__SUFFIX__(z, P, W, k6)
-            for i in range(n):
-                z[i] = y[i] + h*((35.0/384.0)*k1[i] + (500.0/1113.0)*k3[i] + (125.0/192.0)*k4[i]
-                                 - (2187.0/6784.0)*k5[i] + (11.0/84.0)*k6[i])
-            _rhs__SUFFIX__(z, P, W, k7)
+            for s in range(1, 7):
+                for i in range(n):
+                    acc = 0.0
+                    for j in range(s):
+                        acc += DP_A[s, j]*k[j, i]
+                    z[i] = y[i] + h*acc
+                if s == 5:
+                    for i in range(6):
+                        z6[i] = z[i]
+                _rhs__SUFFIX__(z, P, W, k[s])
             err = 0.0
             for i in range(6):
-                e = h*((71.0/57600.0)*k1[i] - (71.0/16695.0)*k3[i] + (71.0/1920.0)*k4[i]
-                       - (17253.0/339200.0)*k5[i] + (22.0/525.0)*k6[i] - (1.0/40.0)*k7[i])
-                err = max(err, abs(e)/tol)
+                e = 0.0
+                for j in range(7):
+                    e += DP_E[j]*k[j, i]
+                err = max(err, abs(h*e)/tol)
             if not (err <= 1.0):  # rejected (NaN included)
                 h *= 0.1 if not math.isfinite(err) else max(0.2, 0.9*err**-0.2)
                 continue
@@ -821,22 +820,26 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
             num = 0.0
             den = 0.0
             for i in range(6):
-                num += (k7[i] - k6[i])**2
+                num += (k[6, i] - k[5, i])**2
                 den += (z[i] - z6[i])**2
             stiff = wait == 0 and h*h*num > W_ENTER*W_ENTER*den
             wait = max(wait - 1, 0)
             taken = False
-            t += h
-            for i in range(n):
-                y0[i] = y[i]
-                f0[i] = k1[i]
-                y[i] = z[i]
-                k1[i] = k7[i]
-            fresh = False
             grow = 5.0 if err < 1e-10 else min(5.0, 0.9*err**-0.2)
+        t += h
+        for i in range(n):
+            y0[i] = y[i]
+            f0[i] = k[0, i]
+            y[i] = z[i]
+        if taken:
+            _rhs__SUFFIX__(y, P, W, k[0])
+        else:
+            for i in range(n):
+                k[0, i] = k[6, i]
+        fresh = False
         stopped = _speed(y, P) < V_STOP
         if stopped:
-            t = _to_stop(y0, f0, y, k1, t, h, P)
+            t = _to_stop(y0, f0, y, k[0], t, h, P)
         if points < path.shape[0]:
             path[points, 0], path[points, 1], path[points, 2], path[points, 3] = t, y[0], y[1], y[2]
             points += 1
