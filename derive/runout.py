@@ -855,9 +855,9 @@ def _wstep__SUFFIX__(y, P, W, h, f0, J, K, z, fz, ynew):
     (I - h GAMMA J) k_i = h f(y + sum_j ALPHA_ij k_j) + h J sum_j GAMMAS_ij k_j
     with J the Jacobian at y (_jac; the distance's row d|v|/dv; each
     sensitivity column takes the state's block, the second derivatives of the
-    wheel forces left out, which a W-method allows). f0 = f(y); writes
-    y1 = y + sum_i B_i k_i to ynew and returns max |y1 - y1_embedded| over
-    the state, the local error estimate."""
+    wheel forces left out, which a W-method allows). f0 = f(y); writes the
+    new state y + sum_i B_i k_i to ynew and returns the largest difference
+    from the embedded solution over the state, the local error estimate."""
     n = y.shape[0]
     hg = h*W_GAMMA
     Q = _w_inverse(J, hg)
@@ -975,8 +975,8 @@ def _stiffness(J, R):
 
 @__JIT__
 def _w_inverse(J, hg):
-    """(I - hg A - hg^2 a_psi e_w')^-1 by its adjugate, A = J[:, 1:4] and
-    a_psi = J[:, 0]: the velocity block of (I - hg J_state) once the
+    """(I - hg A - hg^2 a_psi e_w')^-1 by its adjugate, with A = J[:, 1:4] and
+    a_psi the column J[:, 0]: the velocity block of (I - hg J_state) once the
     positions are eliminated (x, y, psi change by hg times the velocities)."""
     M = np.empty((3, 3))
     for r in range(3):
@@ -1005,8 +1005,8 @@ def _w_stage(K, i, fz, h, hg, J, Q, ex, ey, g):
     """k_i of a ROS34PW2 stage, (I - hg J) k_i = h fz + h J sum_{j<i}
     GAMMAS_ij k_j, block by block: the state y[0:6] with the distance (its row
     of J: (ex, ey) = v/|v| on vx, vy), then each sensitivity column
-    y[7 + 4 r + j] (r = 0..5). Positions: k_p = r_p + hg k_v; velocities:
-    k_v = Q (r_v + hg a_psi r_psi)."""
+    y[7 + 4 r + j] (r = 0..5). The velocities' part is Q (r_v + hg a_psi r_psi),
+    the positions' r_p + hg times it."""
     n = K.shape[1]
     for blk in range(1 + (n - 7)//6):
         off = 0 if blk == 0 else 6 + blk
