@@ -8,14 +8,24 @@ several rtol (the user's alternative) run the same random realistic run-outs
 position from the truth's. Also: run-outs per second of the parallel batch,
 and the fit to rest per vehicle after first use.
 
-    python -m benchmarks runout [--rows 6] [--out benchmarks/results]
+With ``--against REV``: the same figures for the run-out of git revision REV
+in the same process (its generated/runout_jit.py and impactsym/runout/fit.py
+imported beside the checkout's), interleaved with this checkout's, so the
+before/after ratios do not depend on how loaded the machine was.
+
+    python -m benchmarks runout [--rows 6] [--batch 2000] [--against REV] [--out benchmarks/results]
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import importlib.util
 import json
 import math
+import subprocess
+import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -28,6 +38,8 @@ KERNEL_TOLS = (1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
 IVP_RTOLS = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
 REPEATS = 5  # timings are the best of REPEATS (the machine is shared)
 TIMING_COPIES = 20  # the timed batch repeats the compared rows this many times
+ROOT = Path(__file__).resolve().parent.parent
+NOW = "checkout"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -39,39 +51,93 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--out", type=Path, default=Path("benchmarks/results"), help="folder for runout.md/.png/.json"
     )
+    parser.add_argument("--against", metavar="REV", help="also run git revision REV's run-out (same process)")
+
+
+class Version:
+    """One run-out implementation: its kernels module and its fit module."""
+
+    def __init__(self, label: str, jit, fit):
+        self.label, self.jit, self.fit = label, jit, fit
+
+    @contextlib.contextmanager
+    def active(self):
+        """The run-out room's door leads to this version's kernels meanwhile."""
+        from impactsym.runout import _door
+
+        saved = _door.jit
+        _door.jit = lambda: self.jit
+        try:
+            yield self
+        finally:
+            _door.jit = saved
+
+
+def _versions(rev: str | None, folder: Path) -> list:
+    """This checkout's run-out, and REV's when asked."""
+    from impactsym.runout import _door
+
+    fit_now = importlib.import_module("impactsym.runout.fit")
+    found = [Version(NOW, _door.jit(), fit_now)]
+    if rev:
+        from benchmarks.drivers import _old_module
+
+        text = subprocess.run(
+            ["git", "show", f"{rev}:impactsym/runout/fit.py"],
+            cwd=ROOT,
+            check=True,
+            capture_output=True,
+            text=True,
+        ).stdout
+        name = "impactsym.runout._fit_at_revision"  # relative imports resolve to this checkout's room
+        path = folder / "fit_at_revision.py"
+        path.write_text(text)
+        spec = importlib.util.spec_from_file_location(name, path)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+        found.append(Version(rev, _old_module(rev, "runout", folder), module))
+    return found
 
 
 def _errors(rows, xs, ys, truth) -> np.ndarray:
     return np.array([math.hypot(xs[i] - truth[i][0], ys[i] - truth[i][1]) for i in range(len(rows))])
 
 
-def _kernel_curve(rows, truth):
-    """Per tolerance: seconds per run-out (one thread, best of REPEATS over a
-    batch of TIMING_COPIES copies of the rows) and the worst rest error."""
+def _kernel_curves(rows, truth, versions) -> dict:
+    """Per version and tolerance: seconds per run-out (one thread, best of
+    REPEATS over a batch of TIMING_COPIES copies of the rows, the versions
+    alternating) and the worst rest error."""
     from impactsym.runout import runout_batch
     from tests.runout_rows import rows_table
 
     table = rows_table(rows)
     timed = {key: np.tile(value, TIMING_COPIES) for key, value in table.items()}
-    runout_batch(table, parallel=False)  # compile / load
-    curve = []
+    curves = {v.label: [] for v in versions}
+    for v in versions:
+        with v.active():
+            runout_batch(table, parallel=False)  # compile / load
     for tol in KERNEL_TOLS:
-        best = math.inf
+        best = dict.fromkeys(curves, math.inf)
         for _ in range(REPEATS):
-            start = time.perf_counter()
-            runout_batch(timed, tol=tol, parallel=False)
-            best = min(best, time.perf_counter() - start)
-        out = runout_batch(table, tol=tol, parallel=False)
-        err = _errors(rows, out["x_rest"], out["y_rest"], truth)
-        curve.append(
-            {
-                "tol": tol,
-                "seconds_per_runout": best / (len(rows) * TIMING_COPIES),
-                "worst_error_m": float(err.max()),
-                "mean_steps": float(out["steps"].mean()),
-            }
-        )
-    return curve
+            for v in versions:
+                with v.active():
+                    start = time.perf_counter()
+                    runout_batch(timed, tol=tol, parallel=False)
+                    best[v.label] = min(best[v.label], time.perf_counter() - start)
+        for v in versions:
+            with v.active():
+                out = runout_batch(table, tol=tol, parallel=False)
+            err = _errors(rows, out["x_rest"], out["y_rest"], truth)
+            curves[v.label].append(
+                {
+                    "tol": tol,
+                    "seconds_per_runout": best[v.label] / (len(rows) * TIMING_COPIES),
+                    "worst_error_m": float(err.max()),
+                    "mean_steps": float(out["steps"].mean()),
+                }
+            )
+    return curves
 
 
 def _ivp_curve(rows, truth):
@@ -95,95 +161,131 @@ def _at_error(curve, error: float) -> float:
     return min(ok) if ok else math.nan
 
 
-def _throughput(n: int) -> float:
+def _throughput(n: int, versions) -> dict:
+    """Run-outs per second of the parallel batch driver on `n` random rows (default
+    tolerance), per version: the best of REPEATS calls, versions alternating."""
     from impactsym.runout import runout_batch
     from tests.runout_rows import realistic_row, rows_table
 
     rng = np.random.default_rng(11)
     table = rows_table([realistic_row(rng) for _ in range(n)])
-    runout_batch(table)
-    start = time.perf_counter()
-    out = runout_batch(table)
-    elapsed = time.perf_counter() - start
-    assert (out["status"] == 0).all()
-    return n / elapsed
+    best = {v.label: math.inf for v in versions}
+    for v in versions:
+        with v.active():
+            runout_batch(table)
+    for _ in range(REPEATS):
+        for v in versions:
+            with v.active():
+                start = time.perf_counter()
+                out = runout_batch(table)
+                best[v.label] = min(best[v.label], time.perf_counter() - start)
+            assert (out["status"] == 0).all()
+    return {label: n / seconds for label, seconds in best.items()}
 
 
-def _fit_timing() -> dict:
+FIT_CASES = ("all locked", "front locked, rear rolling", "sedan.json: locked, rolling, braked 0.5, steered")
+
+
+def _fit_timing(versions) -> dict:
+    """Fit to rest after first use of examples/runout/sedan.json under three wheel
+    setups: best of 5 (versions alternating), with and without the uniqueness starts."""
     from impactsym.runout import load_runout, runout
-    from impactsym.runout.fit import fit_rest
 
-    scene = json.loads(Path("examples/runout/sedan.json").read_text())
-    cases = []
-    for wheels in (
+    scene = json.loads((ROOT / "examples/runout/sedan.json").read_text())
+    setups = (
         "locked",
         {"front_left": "locked", "front_right": "locked", "rear_left": "rolling", "rear_right": "rolling"},
         scene["vehicles"][0]["wheels"],
-    ):
+    )
+    cases = []
+    for label, wheels in zip(FIT_CASES, setups):
         s = json.loads(json.dumps(scene))
         s["vehicles"][0]["wheels"] = wheels
         rest = runout(s)["vehicles"][0]["rest"]
         del s["vehicles"][0]["separation"]["velocity"], s["vehicles"][0]["separation"]["yaw_rate"]
         s["vehicles"][0]["rest"] = rest
         veh = load_runout(s).vehicles[0]
-        fit_rest(veh)  # first use
-        best = math.inf
-        for _ in range(3):
-            start = time.perf_counter()
-            fit = fit_rest(veh)
-            best = min(best, time.perf_counter() - start)
-        single = math.inf
-        for _ in range(3):
-            start = time.perf_counter()
-            fit_rest(veh, check_unique=False)
-            single = min(single, time.perf_counter() - start)
-        cases.append(
-            {
-                "wheels": str(wheels)[:60],
-                "ms": best * 1e3,
-                "ms_one_start": single * 1e3,
+        row = {"wheels": label}
+        times = {v.label: [math.inf, math.inf] for v in versions}
+        fits = {}
+        for v in versions:
+            with v.active():
+                fits[v.label] = v.fit.fit_rest(veh)  # first use
+        for _ in range(5):
+            for v in versions:
+                with v.active():
+                    for k, unique in enumerate((True, False)):
+                        start = time.perf_counter()
+                        v.fit.fit_rest(veh, check_unique=unique)
+                        times[v.label][k] = min(times[v.label][k], time.perf_counter() - start)
+        for v in versions:
+            fit = fits[v.label]
+            row[v.label] = {
+                "ms": times[v.label][0] * 1e3,
+                "ms_one_start": times[v.label][1] * 1e3,
                 "iterations": fit.iterations,
                 "converged": fit.converged,
                 "velocity": fit.velocity,
                 "yaw_rate": fit.yaw_rate,
             }
-        )
+        cases.append(row)
     return {"cases": cases}
 
 
-def _fit_random(n: int) -> dict:
+def _fit_random(n: int, version) -> dict:
     """Round trips on random realistic run-outs: forward, then fitted to the rest
     pose reached. Counts fits that converged, that recovered the generating
     state (0.01 m/s, 0.01 rad/s; the reported state or a named alternative),
-    and that reached the rest pose from another state without naming it."""
+    that reached the rest pose from another state without naming the
+    generating one, and the named alternatives that are spurious (run forward
+    at the default tolerance, they miss the rest pose by more than 1 mm or
+    0.01 deg, or they repeat another state found within 0.01 m/s and 0.01 rad/s)."""
     from impactsym.runout.batch import run_row
-    from impactsym.runout.fit import fit_rest
     from impactsym.runout.scene import RunoutVehicle
     from tests.runout_rows import realistic_row
 
     rng = np.random.default_rng(5)
-    counts = {"rows": n, "converged": 0, "recovered": 0, "other_state_unnamed": 0}
+    counts = {"rows": n, "converged": 0, "recovered": 0, "other_state_unnamed": 0, "alternatives": 0}
+    counts["spurious_alternatives"] = 0
     times = []
-    for _ in range(n):
-        row = realistic_row(rng)
-        y, _, _, _, _ = run_row(np.array([row[c] for c in _columns()]))
-        fixed = {k: v for k, v in row.items() if k not in ("vx", "vy", "w")}
-        veh = RunoutVehicle("r", fixed, (row["x"], row["y"]), row["psi"], None, None, (y[0], y[1], y[2]))
-        start = time.perf_counter()
-        fit = fit_rest(veh)
-        times.append(time.perf_counter() - start)
-        found = [fit, *fit.alternatives]
-        hit = any(
-            math.hypot(f.velocity[0] - row["vx"], f.velocity[1] - row["vy"]) < 0.01
-            and abs(f.yaw_rate - row["w"]) < 0.01
-            for f in found
-        )
-        counts["converged"] += fit.converged
-        counts["recovered"] += fit.converged and hit
-        counts["other_state_unnamed"] += fit.converged and not hit
+    with version.active():
+        for _ in range(n):
+            row = realistic_row(rng)
+            y, _, _, _, _ = run_row(np.array([row[c] for c in _columns()]))
+            fixed = {k: v for k, v in row.items() if k not in ("vx", "vy", "w")}
+            veh = RunoutVehicle("r", fixed, (row["x"], row["y"]), row["psi"], None, None, (y[0], y[1], y[2]))
+            start = time.perf_counter()
+            fit = version.fit.fit_rest(veh)
+            times.append(time.perf_counter() - start)
+            found = [fit, *fit.alternatives]
+            hit = any(_same(f, (row["vx"], row["vy"], row["w"])) for f in found)
+            counts["converged"] += fit.converged
+            counts["recovered"] += fit.converged and hit
+            counts["other_state_unnamed"] += fit.converged and not hit
+            counts["alternatives"] += len(fit.alternatives)
+            for i, alt in enumerate(fit.alternatives):
+                ya, _, status, _, _ = run_row(
+                    np.array(
+                        [
+                            dict(row, vx=alt.velocity[0], vy=alt.velocity[1], w=alt.yaw_rate)[c]
+                            for c in _columns()
+                        ]
+                    )
+                )
+                missed = (
+                    status != 0
+                    or math.hypot(ya[0] - y[0], ya[1] - y[1]) > 1e-3
+                    or abs(ya[2] - y[2]) > math.radians(0.01)
+                )
+                repeated = any(_same(g, (*alt.velocity, alt.yaw_rate)) for g in found[: i + 1])
+                counts["spurious_alternatives"] += missed or repeated
     counts["median_ms"] = float(np.median(times) * 1e3)
     counts["max_ms"] = float(np.max(times) * 1e3)
     return counts
+
+
+def _same(f, p) -> bool:
+    return math.hypot(f.velocity[0] - p[0], f.velocity[1] - p[1]) < 0.01 and abs(f.yaw_rate - p[2]) < 0.01
 
 
 def _closed_forms() -> list[dict]:
@@ -241,35 +343,52 @@ def _columns():
 
 
 def main(args: argparse.Namespace) -> int:
+    import os
+
     from impactsym.testing.runout_reference import reference_runout
     from tests.runout_rows import realistic_row
 
+    load_before = os.getloadavg()
     rng = np.random.default_rng(2024)
     rows = [realistic_row(rng) for _ in range(args.rows)]
     start = time.perf_counter()
     truth = [reference_runout(r) for r in rows]
     truth_seconds = (time.perf_counter() - start) / len(rows)
-    kernel, ivp = _kernel_curve(rows, truth), _ivp_curve(rows, truth)
-    default = next(p for p in kernel if p["tol"] == 1e-8)
-    ratios = []
-    for p in kernel:
-        ivp_s = _at_error(ivp, p["worst_error_m"])
-        ratios.append(
-            {"tol": p["tol"], "error": p["worst_error_m"], "ratio": ivp_s / p["seconds_per_runout"]}
-        )
-    result = {
-        "rows": len(rows),
-        "truth_seconds_per_runout": truth_seconds,
-        "kernel": kernel,
-        "solve_ivp_RK45": ivp,
-        "ratios_at_equal_error": ratios,
-        "runouts_per_second_parallel": _throughput(args.batch),
-        "runouts_per_second_one_thread_default_tol": 1.0 / default["seconds_per_runout"],
-        "fit": _fit_timing(),
-        "fit_random": _fit_random(args.fits),
-        "closed_forms": _closed_forms(),
-        "reference_10_rows": _reference_check(),
-    }
+    with tempfile.TemporaryDirectory(prefix="impactsym_runout_") as tmp:
+        versions = _versions(args.against, Path(tmp))
+        kernel, ivp = _kernel_curves(rows, truth, versions), _ivp_curve(rows, truth)
+        ratios = {
+            label: [
+                {
+                    "tol": p["tol"],
+                    "error": p["worst_error_m"],
+                    "ratio": _at_error(ivp, p["worst_error_m"]) / p["seconds_per_runout"],
+                }
+                for p in curve
+            ]
+            for label, curve in kernel.items()
+        }
+        result = {
+            "command": "python -m benchmarks runout "
+            + f"--rows {args.rows} --batch {args.batch} --fits {args.fits}"
+            + (f" --against {args.against}" if args.against else ""),
+            "versions": [v.label for v in versions],
+            "rows": len(rows),
+            "truth_seconds_per_runout": truth_seconds,
+            "kernel": kernel,
+            "solve_ivp_RK45": ivp,
+            "ratios_at_equal_error": ratios,
+            "runouts_per_second_parallel": _throughput(args.batch, versions),
+            "runouts_per_second_one_thread_default_tol": {
+                label: 1.0 / next(p for p in curve if p["tol"] == 1e-8)["seconds_per_runout"]
+                for label, curve in kernel.items()
+            },
+            "fit": _fit_timing(versions),
+            "fit_random": {v.label: _fit_random(args.fits, v) for v in versions},
+            "closed_forms": _closed_forms(),
+            "reference_10_rows": _reference_check(),
+            "load_average": {"start": load_before, "end": os.getloadavg()},
+        }
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "runout.json").write_text(json.dumps(result, indent=1))
     _chart(kernel, ivp, args.out / "runout.png")
@@ -278,49 +397,60 @@ def main(args: argparse.Namespace) -> int:
     return 0
 
 
-def _chart(kernel, ivp, path: Path) -> None:
+def _chart(kernel: dict, ivp, path: Path) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
-    ax.loglog(
-        [p["worst_error_m"] for p in kernel],
-        [p["seconds_per_runout"] for p in kernel],
-        "o-",
-        label="impactsym batch kernel (DP5(4), one thread), tol 1e-4..1e-10",
-    )
+    for label, curve in kernel.items():
+        ax.loglog(
+            [p["worst_error_m"] for p in curve],
+            [p["seconds_per_runout"] for p in curve],
+            "o-" if label == NOW else "^--",
+            label=f"impactsym batch kernel, one thread, tol 1e-4..1e-10 ({label})",
+        )
     ax.loglog(
         [p["worst_error_m"] for p in ivp],
         [p["seconds_per_runout"] for p in ivp],
         "s-",
-        label="scipy solve_ivp RK45, rtol 1e-3..1e-8",
+        label="scipy solve_ivp RK45, rtol 1e-3..1e-10",
     )
     ax.axvline(1e-3, color="0.5", ls=":", lw=1)
     ax.set_xlabel("worst rest-position error against DOP853 rtol 1e-10 [m]")
     ax.set_ylabel("run time per run-out [s]")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.15))
     ax.grid(True, which="both", alpha=0.3)
     fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
 
 
 def _markdown(r: dict) -> str:
+    labels = r["versions"]
+    load = r["load_average"]
     lines = [
-        "# Run-out benchmark (`python -m benchmarks runout`)",
+        f"# Run-out benchmark (`{r['command']}`)",
+        "",
+        f"Load average (1, 5, 15 min) at the start {', '.join(f'{x:.1f}' for x in load['start'])}, "
+        f"at the end {', '.join(f'{x:.1f}' for x in load['end'])} (2 cores, shared).",
         "",
         f"{r['rows']} random realistic run-outs; truth: solve_ivp DOP853 rtol 1e-10 "
-        f"({r['truth_seconds_per_runout']:.2f} s per run-out).",
+        f"({r['truth_seconds_per_runout']:.2f} s per run-out). Versions: "
+        + ", ".join(labels)
+        + " (same process, alternating).",
         "",
-        "| kernel tol | s per run-out (1 thread) | worst rest error [m] | mean steps | solve_ivp RK45 at equal error / kernel |",
-        "|---|---|---|---|---|",
+        "| kernel tol | version | s per run-out (1 thread) | worst rest error [m] | mean steps "
+        "| solve_ivp RK45 at equal error / kernel |",
+        "|---|---|---|---|---|---|",
     ]
-    for p, q in zip(r["kernel"], r["ratios_at_equal_error"]):
-        lines.append(
-            f"| {p['tol']:.0e} | {p['seconds_per_runout']:.2e} | {p['worst_error_m']:.2e} | "
-            f"{p['mean_steps']:.0f} | {q['ratio']:.0f} |"
-        )
+    for i, tol in enumerate(KERNEL_TOLS):
+        for label in labels:
+            p, q = r["kernel"][label][i], r["ratios_at_equal_error"][label][i]
+            lines.append(
+                f"| {tol:.0e} | {label} | {p['seconds_per_runout']:.2e} | {p['worst_error_m']:.2e} | "
+                f"{p['mean_steps']:.0f} | {q['ratio']:.0f} |"
+            )
     lines += ["", "| solve_ivp RK45 rtol | s per run-out | worst rest error [m] |", "|---|---|---|"]
     lines += [
         f"| {p['rtol']:.0e} | {p['seconds_per_runout']:.2e} | {p['worst_error_m']:.2e} |"
@@ -328,16 +458,29 @@ def _markdown(r: dict) -> str:
     ]
     lines += [
         "",
-        f"Parallel batch (default tol 1e-8): {r['runouts_per_second_parallel']:.0f} run-outs/s; "
-        f"one thread: {r['runouts_per_second_one_thread_default_tol']:.0f} run-outs/s.",
-        "",
-        "| fit to rest (after first use) | ms (scan + 3 Newton starts, fit.py) | ms (one start) | iterations | converged |",
-        "|---|---|---|---|---|",
+        "| version | run-outs/s, parallel batch (2 threads) | run-outs/s, one thread | "
+        "worst / least ratio to RK45 over the sweep |",
+        "|---|---|---|---|",
     ]
+    for label in labels:
+        ratios = [q["ratio"] for q in r["ratios_at_equal_error"][label]]
+        lines.append(
+            f"| {label} | {r['runouts_per_second_parallel'][label]:.0f} | "
+            f"{r['runouts_per_second_one_thread_default_tol'][label]:.0f} | {min(ratios):.0f} / {max(ratios):.0f} |"
+        )
     lines += [
-        f"| {c['wheels']} | {c['ms']:.1f} | {c['ms_one_start']:.1f} | {c['iterations']} | {c['converged']} |"
-        for c in r["fit"]["cases"]
+        "",
+        "| fit to rest (after first use) | version | ms (scan + uniqueness starts) | ms (one start) "
+        "| iterations | converged |",
+        "|---|---|---|---|---|---|",
     ]
+    for c in r["fit"]["cases"]:
+        for label in labels:
+            f = c[label]
+            lines.append(
+                f"| {c['wheels']} | {label} | {f['ms']:.1f} | {f['ms_one_start']:.1f} | {f['iterations']} | "
+                f"{f['converged']} |"
+            )
     lines += [
         "",
         "| closed form (tests/test_runout_model.py) | run-out | closed form | error |",
@@ -354,13 +497,15 @@ def _markdown(r: dict) -> str:
         f"Against solve_ivp DOP853 rtol 1e-10 on the 10 rows of tests/test_runout_reference.py: worst "
         f"rest-position error {ref['position_m']:.2e} m, heading {ref['heading_deg']:.1e} deg, "
         f"{100 * ref['share_of_allowance']:.1f} % of the allowance 1 mm + 1e-5 of the path.",
-    ]
-    fr = r["fit_random"]
-    lines += [
         "",
-        f"Fit round trips on {fr['rows']} random realistic run-outs: {fr['converged']} converged, "
-        f"{fr['recovered']} recovered the generating state (reported or named as an alternative), "
-        f"{fr['other_state_unnamed']} reached the rest pose from another state without naming the "
-        f"generating one; median {fr['median_ms']:.1f} ms, max {fr['max_ms']:.1f} ms per fit.",
     ]
+    for label in labels:
+        fr = r["fit_random"][label]
+        lines.append(
+            f"Fit round trips ({label}) on {fr['rows']} random realistic run-outs: {fr['converged']} converged, "
+            f"{fr['recovered']} recovered the generating state (reported or named as an alternative), "
+            f"{fr['other_state_unnamed']} reached the rest pose from another state without naming the "
+            f"generating one; {fr['alternatives']} alternatives named, {fr['spurious_alternatives']} of them "
+            f"spurious; median {fr['median_ms']:.1f} ms, max {fr['max_ms']:.1f} ms per fit."
+        )
     return "\n".join(lines) + "\n"

@@ -15,33 +15,44 @@ point moves at u = v + w·(-ry, rx); u_l is the component of u along the wheel
 
 m dv/dt = sum F, I dw/dt = sum r x F.
 
-Smoothing near zero speed (the contract leaves it to the implementation): every
-speed that divides or gives a sign enters as max(|u|, eps), eps = EPS = 0.5 mm/s
-(``Modulus``): sgn(u) becomes u/max(|u|, eps), u/|u| becomes u/max(|u|, eps),
-and alpha·sgn(u_s) becomes atan2(u_s, max(|u_l|, eps)). Above eps every force
-is the contract's exactly (a smooth u/sqrt(u^2 + eps^2) was tried first: its
-relative deviation eps^2/(2u^2) reaches far above eps and moved a rolling
-run-out from 20 m/s by 1.2 mm at eps = 5 mm/s); below eps the forces fade
-linearly with speed, so the equations are Lipschitz (an explicit RK
-integrates them). Two effects move the rest pose, both measured (eps against
-eps/10 on random realistic run-outs, tests/test_runout_model.py; at eps = 5
-mm/s the second one reached 2.0 mm and 0.03 deg, hence 0.5 mm/s): the creep
-below eps, eps^2/(2a) (a the deceleration; 1e-6 m even for rolling
-resistance alone), and the creep of a wheel that sticks (a braked or
-rolling wheel whose sgn(u_l) holds against the other forces, as static
-friction would): its u_l settles at a share of eps instead of 0, so the
-vehicle creeps by a distance proportional to eps for as long as it sticks
-(0.3 mm and 0.005 deg worst measured). The run-out ends when
-|v| + |w| R_max < V_STOP = 1 mm/s (R_max the farthest wheel from the centre
-of gravity): above eps the forces are the sharp ones, so the remaining travel
-is at most V_STOP^2/(2 f_r g) = 5 um.
+Smoothing near zero speed (the contract leaves it to the implementation):
+every speed that divides or gives a sign enters as max(|u|, eps), eps = EPS =
+0.5 mm/s (``Modulus``): sgn(u) becomes u/max(|u|, eps), u/|u| becomes
+u/max(|u|, eps), and alpha·sgn(u_s) becomes atan2(u_s, max(|u_l|, eps)). Above
+eps every force is the contract's exactly (a smooth u/sqrt(u^2 + eps^2) was
+tried first: its relative deviation eps^2/(2u^2) reaches far above eps and
+moved a rolling run-out from 20 m/s by 1.2 mm at eps = 5 mm/s); below eps the
+forces fade linearly with speed, so the equations are Lipschitz (but stiff:
+below). Two effects move the rest pose, both measured (eps against eps/10 on
+random realistic run-outs, tests/test_runout_model.py; at eps = 5 mm/s the
+second one reached 2.0 mm and 0.03 deg, hence 0.5 mm/s): the creep below eps,
+eps^2/(2a) (a the deceleration; 1e-6 m even for rolling resistance alone), and
+the creep of a wheel that sticks (a braked or rolling wheel whose sgn(u_l)
+holds against the other forces, as static friction would): its u_l settles at
+a share of eps instead of 0, so the vehicle creeps by a distance proportional
+to eps for as long as it sticks (0.3 mm and 0.005 deg worst measured). The
+run-out ends when |v| + |w| R_max < V_STOP = 1 mm/s (R_max the farthest wheel
+from the centre of gravity): above eps the forces are the sharp ones, so the
+remaining travel is at most V_STOP^2/(2 f_r g) = 5 um.
+
+Stiffness: below eps a sliding wheel's force is a damper of slope mu N/eps
+(locked: both directions; braked: along; rolling: along with f_r N/eps, and
+across with mu N/(alpha_max max(|u_l|, eps)) at low speed). A wheel that
+sticks (a locked wheel the car pivots about, a braked wheel holding) keeps
+it there for as long as it sticks, with |lambda| up to ~1e4 1/s, where an
+explicit step must stay below ~3/|lambda| (measured: 2,600 Dormand-Prince
+steps of 0.25 ms for one run-out of examples/runout/sedan.json). The
+integrator therefore switches per step: Dormand-Prince 5(4) while h |lambda|
+is small, the L-stable Rosenbrock-W method ROS34PW2 (linearly implicit with
+the emitted Jacobian; its order conditions are proved below) while a wheel
+makes the equations stiff.
 
 Emitted (``render``): generated/runout.py (plain: the constants, columns and
 status codes) and generated/runout_jit.py (numba: the wheel forces and their
 Jacobians with respect to (psi, vx, vy, w, mu), the right-hand side with its
-sensitivity equations, and the adaptive Dormand-Prince 5(4) integrator with its
-batch drivers; all in one file because numba's cache does not notice a change
-of a jitted callee in another file).
+sensitivity equations, the adaptive Dormand-Prince 5(4) / ROS34PW2 integrator
+with its batch drivers; all in one file because numba's cache does not notice
+a change of a jitted callee in another file).
 """
 
 from __future__ import annotations
@@ -60,6 +71,38 @@ MAX_STEPS = 200_000  # accepted plus rejected steps per row
 TOL = 1e-8  # default local error tolerance per step (m, rad, m/s, rad/s; absolute)
 H0 = 1e-3  # s, first trial step
 H_MAX = 0.25  # s, longest step (keeps the path output legible)
+
+# Stiff steps: ROS34PW2 (Rang & Angermann, BIT 45 (2005) 761-787: 4 stages,
+# order 3 with an embedded order-2 solution, L-stable, stiffly accurate; a
+# W-method, so its order holds with an approximate Jacobian, and built to keep
+# it on stiff singularly perturbed problems, which a sticking wheel is), in the
+# form (I - h GAMMA J) k_i = h f(y + sum_j ALPHA_ij k_j) + h J sum_j GAMMAS_ij k_j,
+# y1 = y + sum_i B_i k_i. The order conditions are checked before emission.
+W_GAMMA = 4.3586652150845900e-01
+W_ALPHA = (
+    (),
+    (8.7173304301691801e-01,),
+    (8.4457060015369423e-01, -1.1299064236484185e-01),
+    (0.0, 0.0, 1.0),
+)
+W_GAMMAS = (
+    (),
+    (-8.7173304301691801e-01,),
+    (-9.0338057013044082e-01, 5.4180672388095326e-02),
+    (2.4212380706095346e-01, -1.2232505839045147e00, 5.4526025533510214e-01),
+)
+W_B = (2.4212380706095346e-01, -1.2232505839045147e00, 1.5452602553351020e00, 4.3586652150845900e-01)
+W_B_EMBEDDED = (3.7810903145819369e-01, -9.6042292212423178e-02, 0.5, 2.1793326075422950e-01)
+# Switching (docs/runout.md): a Dormand-Prince step with h |lambda| above
+# W_ENTER (its stability interval on the negative axis ends near 3.3; its
+# estimate of |lambda| runs low) hands over to ROS34PW2, which hands back when h
+# times the Jacobian's bound on |lambda| falls below W_LEAVE.
+W_ENTER = 2.0
+W_LEAVE = 2.0
+# A hand-over refused at once (h |lambda| bound below W_LEAVE: the explicit step
+# is as long as the stiff one would be) is not tried again for W_WAIT steps
+# (each try costs a Jacobian: a fifth of a step).
+W_WAIT = 10
 
 # Row status codes of runout_batch (0 solved). 1 and 2 mean what they mean in
 # solve_batch (derive/codes.py); 20-23 are the run-out's own.
@@ -338,9 +381,58 @@ def _check_jacobian(g_num, j_num, vals, ok, worst):
     return ok, worst
 
 
+def _stiff_step_claims():
+    """ROS34PW2's tables (Hairer & Wanner IV.7, Table 7.1 conditions, beta = alpha
+    + gamma): B has order 3, B_EMBEDDED order 2, the method is stiffly accurate
+    (B = the last row of beta with GAMMA on the diagonal), and where the
+    Jacobian it is given is zero (a W-method's row) it is an explicit
+    Runge-Kutta method of order 3 (B alpha^k = 1/(k + 1), B ALPHA alpha = 1/6); all to 1e-14 in
+    50-digit arithmetic."""
+    with mpmath.workdps(50):
+        g = mpmath.mpf(W_GAMMA)
+        alpha = [[mpmath.mpf(x) for x in r] + [0] * (4 - len(r)) for r in W_ALPHA]
+        beta = [
+            [alpha[i][j] + (mpmath.mpf(W_GAMMAS[i][j]) if j < i else 0) for j in range(4)] for i in range(4)
+        ]
+        a = [sum(r) for r in alpha]
+        bp = [sum(r) for r in beta]
+
+        def misfits(b, order):
+            b = [mpmath.mpf(x) for x in b]
+            out = [sum(b) - 1, sum(bi * x for bi, x in zip(b, bp)) - (mpmath.mpf(1) / 2 - g)]
+            if order >= 3:
+                bbb = sum(b[i] * beta[i][j] * bp[j] for i in range(4) for j in range(4))
+                out += [
+                    sum(bi * x * x for bi, x in zip(b, a)) - mpmath.mpf(1) / 3,
+                    bbb - (mpmath.mpf(1) / 6 - g + g * g),
+                ]
+            return out
+
+        tiny = mpmath.mpf(10) ** -14
+        order3 = all(abs(x) < tiny for x in misfits(W_B, 3))
+        order2 = all(abs(x) < tiny for x in misfits(W_B_EMBEDDED, 2))
+        stiffly = all(abs(beta[3][j] + (g if j == 3 else 0) - mpmath.mpf(W_B[j])) < tiny for j in range(4))
+        quad = all(
+            abs(sum(mpmath.mpf(bi) * x**k for bi, x in zip(W_B, a)) - mpmath.mpf(1) / (k + 1)) < tiny
+            for k in range(3)
+        )
+        tall = sum(mpmath.mpf(W_B[i]) * alpha[i][j] * a[j] for i in range(4) for j in range(4))
+        quad = quad and abs(tall - mpmath.mpf(1) / 6) < tiny
+    return [
+        (
+            "run-out: ROS34PW2 (stiff steps) has order 3, its embedded solution order 2 (1e-14)",
+            order3 and order2,
+        ),
+        (
+            "run-out: ROS34PW2 is stiffly accurate, and of order 3 as an explicit method where J = 0",
+            stiffly and quad,
+        ),
+    ]
+
+
 def proofs():
     """(claim, passed) for the run-out model."""
-    return _symbolic_claims() + _numeric_claims()
+    return _symbolic_claims() + _numeric_claims() + _stiff_step_claims()
 
 
 # --- emission ------------------------------------------------------------------
@@ -407,6 +499,45 @@ def _constants() -> list[str]:
     ] + [f"STATUS_{k} = {v!r}" for k, v in STATUS.items()]
 
 
+# Dormand-Prince 5(4) (Dormand & Prince 1980): stage rows DP_A (the seventh is
+# the fifth-order solution, FSAL), error weights DP_E = b5 - b4.
+DP_A = (
+    (),
+    ("1/5",),
+    ("3/40", "9/40"),
+    ("44/45", "-56/15", "32/9"),
+    ("19372/6561", "-25360/2187", "64448/6561", "-212/729"),
+    ("9017/3168", "-355/33", "46732/5247", "49/176", "-5103/18656"),
+    ("35/384", "0", "500/1113", "125/192", "-2187/6784", "11/84"),
+)
+DP_E = ("71/57600", "0", "-71/16695", "71/1920", "-17253/339200", "22/525", "-1/40")
+
+
+def _w_constants() -> list[str]:
+    """The Dormand-Prince and ROS34PW2 tables as numba-frozen arrays (numba folds global arrays into the code)."""
+
+    def table(rows, width=4):
+        full = [list(r) + [0.0] * (width - len(r)) for r in rows]
+        return "np.array([" + ", ".join("[" + ", ".join(repr(x) for x in r) + "]" for r in full) + "])"
+
+    def table7(rows):
+        return table(rows, 7)
+
+    dp = [[float(sp.Rational(x)) for x in r] for r in DP_A]
+    return [
+        f"DP_A = {table7(dp)}",
+        f"DP_E = np.array({[float(sp.Rational(x)) for x in DP_E]!r})",
+        f"W_GAMMA = {W_GAMMA!r}",
+        f"W_ALPHA = {table(W_ALPHA)}",
+        f"W_GAMMAS = {table(W_GAMMAS)}",
+        f"W_B = np.array({list(W_B)!r})",
+        f"W_E = np.array({[b - e for b, e in zip(W_B, W_B_EMBEDDED)]!r})  # B - B_EMBEDDED",
+        f"W_ENTER = {W_ENTER!r}  # h |lambda| that hands a step to ROS34PW2",
+        f"W_LEAVE = {W_LEAVE!r}  # h |lambda| bound below which Dormand-Prince takes over again",
+        f"W_WAIT = {W_WAIT!r}  # Dormand-Prince steps before a refused hand-over is tried again",
+    ]
+
+
 def render_plain(digest: str) -> str:
     """generated/runout.py: constants, columns, outputs and status texts (plain Python)."""
     parts = [
@@ -459,6 +590,7 @@ def render(digest: str) -> dict[str, str]:
         "from numba import njit, prange",
         "",
         *_constants(),
+        *_w_constants(),
         "",
         *("\n" + f for f in funcs),
         INTEGRATOR_SOURCE,
@@ -607,78 +739,296 @@ def _setup(v, eps):
 __ROW____BATCH__'''
 INTEGRATE_TEMPLATE = '''@__JIT__
 def _integrate__SUFFIX__(y, P, W, tol, path):
-    """Adaptive Dormand-Prince 5(4) (FSAL, local extrapolation) from t = 0 until
-    the vehicle stops (_speed < V_STOP), in place on y. The local error of the
-    state (x, y, psi, vx, vy, w) is kept below `tol` (absolute, SI) per step;
-    the distance and the sensitivities ride on the same steps. Accepted points
-    (t, x, y, psi) go to `path` while it has room. Returns (t, status, steps,
-    points)."""
+    """Adaptive integration from t = 0 until the vehicle stops (_speed < V_STOP),
+    in place on y. Non-stiff steps: Dormand-Prince 5(4) (FSAL, local
+    extrapolation; tableau DP_A, error weights DP_E). Stiff steps (a wheel near
+    stick, where a smoothed sign is a damper of slope mu N/EPS): the L-stable
+    Rosenbrock-W method ROS34PW2 (_wstep). A Dormand-Prince step whose estimate
+    h |lambda| (Hairer's, from its last two stages) exceeds W_ENTER hands the
+    next step to ROS34PW2; a ROS34PW2 step whose h |lambda| (_stiffness, from
+    the Jacobian) is below W_LEAVE hands back. The local error of the state
+    (x, y, psi, vx, vy, w) is kept below `tol` (absolute, SI) per step; the
+    distance and the sensitivities ride on the same steps. The step in which
+    the vehicle stops is cut back to where _speed falls through V_STOP
+    (_to_stop). Accepted points (t, x, y, psi) go to `path` while it has room.
+    Returns (t, status, steps, points). (The stages are a loop with one call of
+    the right-hand side, not written out: numba inlines every call site, and
+    seven of them tripled the compile time of first use.)"""
     n = y.shape[0]
-    k1 = np.empty(n)
-    k2 = np.empty(n)
-    k3 = np.empty(n)
-    k4 = np.empty(n)
-    k5 = np.empty(n)
-    k6 = np.empty(n)
-    k7 = np.empty(n)
+    k = np.empty((7, n))
     z = np.empty(n)
+    z6 = np.empty(6)
+    y0 = np.empty(n)
+    f0 = np.empty(n)
+    K = np.empty((4, n))
+    J = np.empty((3, 4))
     t = 0.0
     h = H0
     steps = 0
     points = 0
+    stiff = False
+    taken = False  # the last step was a ROS34PW2 step
+    wait = 0  # Dormand-Prince steps before the stiffness is looked at again
+    fresh = False  # J holds the Jacobian at y
     if path.shape[0] > 0:
         path[0, 0], path[0, 1], path[0, 2], path[0, 3] = 0.0, y[0], y[1], y[2]
         points = 1
     if _speed(y, P) < V_STOP:
         return t, STATUS_OK, steps, points
-    _rhs__SUFFIX__(y, P, W, k1)
+    _rhs__SUFFIX__(y, P, W, k[0])
     while True:
         if steps >= MAX_STEPS or t >= T_MAX:
             return t, STATUS_RUNOUT_NOT_STOPPED, steps, points
         steps += 1
-        for i in range(n):
-            z[i] = y[i] + h*(0.2*k1[i])
-        _rhs__SUFFIX__(z, P, W, k2)
-        for i in range(n):
-            z[i] = y[i] + h*(0.075*k1[i] + 0.225*k2[i])
-        _rhs__SUFFIX__(z, P, W, k3)
-        for i in range(n):
-            z[i] = y[i] + h*((44.0/45.0)*k1[i] - (56.0/15.0)*k2[i] + (32.0/9.0)*k3[i])
-        _rhs__SUFFIX__(z, P, W, k4)
-        for i in range(n):
-            z[i] = y[i] + h*((19372.0/6561.0)*k1[i] - (25360.0/2187.0)*k2[i] + (64448.0/6561.0)*k3[i]
-                             - (212.0/729.0)*k4[i])
-        _rhs__SUFFIX__(z, P, W, k5)
-        for i in range(n):
-            z[i] = y[i] + h*((9017.0/3168.0)*k1[i] - (355.0/33.0)*k2[i] + (46732.0/5247.0)*k3[i]
-                             + (49.0/176.0)*k4[i] - (5103.0/18656.0)*k5[i])
-        _rhs__SUFFIX__(z, P, W, k6)
-        for i in range(n):
-            z[i] = y[i] + h*((35.0/384.0)*k1[i] + (500.0/1113.0)*k3[i] + (125.0/192.0)*k4[i]
-                             - (2187.0/6784.0)*k5[i] + (11.0/84.0)*k6[i])
-        _rhs__SUFFIX__(z, P, W, k7)
-        err = 0.0
-        for i in range(6):
-            e = h*((71.0/57600.0)*k1[i] - (71.0/16695.0)*k3[i] + (71.0/1920.0)*k4[i]
-                   - (17253.0/339200.0)*k5[i] + (22.0/525.0)*k6[i] - (1.0/40.0)*k7[i])
-            err = max(err, abs(e)/tol)
-        if not (err <= 1.0):  # rejected (NaN included)
-            if not math.isfinite(err):
-                h *= 0.1
-            else:
-                h *= max(0.2, 0.9*err**-0.2)
-            continue
+        if stiff:
+            if not fresh:
+                _jac(y, P, W, J)
+                fresh = True
+            stiff = h*_stiffness(J, P[5]) >= W_LEAVE
+            if not (stiff or taken):  # handed straight back: look again W_WAIT steps later
+                wait = W_WAIT
+        if stiff:
+            taken = True
+            err = _wstep__SUFFIX__(y, P, W, h, k[0], J, K, z, k[1], k[2])/tol
+            if not (err <= 1.0):  # rejected (NaN included)
+                h *= 0.1 if not math.isfinite(err) else max(0.2, 0.9*err**(-1.0/3.0))
+                continue
+            for i in range(n):
+                z[i] = k[2, i]
+            grow = 5.0 if err < 1e-10 else min(5.0, 0.9*err**(-1.0/3.0))
+        else:
+            for s in range(1, 7):
+                for i in range(n):
+                    acc = 0.0
+                    for j in range(s):
+                        acc += DP_A[s, j]*k[j, i]
+                    z[i] = y[i] + h*acc
+                if s == 5:
+                    for i in range(6):
+                        z6[i] = z[i]
+                _rhs__SUFFIX__(z, P, W, k[s])
+            err = 0.0
+            for i in range(6):
+                e = 0.0
+                for j in range(7):
+                    e += DP_E[j]*k[j, i]
+                err = max(err, abs(h*e)/tol)
+            if not (err <= 1.0):  # rejected (NaN included)
+                h *= 0.1 if not math.isfinite(err) else max(0.2, 0.9*err**-0.2)
+                continue
+            # Hairer's stiffness estimate (DOPRI5): |lambda| ~ |k7 - k6|/|z7 - z6|
+            num = 0.0
+            den = 0.0
+            for i in range(6):
+                num += (k[6, i] - k[5, i])**2
+                den += (z[i] - z6[i])**2
+            stiff = wait == 0 and h*h*num > W_ENTER*W_ENTER*den
+            wait = max(wait - 1, 0)
+            taken = False
+            grow = 5.0 if err < 1e-10 else min(5.0, 0.9*err**-0.2)
         t += h
         for i in range(n):
+            y0[i] = y[i]
+            f0[i] = k[0, i]
             y[i] = z[i]
-            k1[i] = k7[i]
+        if taken:
+            _rhs__SUFFIX__(y, P, W, k[0])
+        else:
+            for i in range(n):
+                k[0, i] = k[6, i]
+        fresh = False
+        stopped = _speed(y, P) < V_STOP
+        if stopped:
+            t = _to_stop(y0, f0, y, k[0], t, h, P)
         if points < path.shape[0]:
             path[points, 0], path[points, 1], path[points, 2], path[points, 3] = t, y[0], y[1], y[2]
             points += 1
-        if _speed(y, P) < V_STOP:
+        if stopped:
             return t, STATUS_OK, steps, points
-        grow = 5.0 if err < 1e-10 else min(5.0, 0.9*err**-0.2)
         h = min(h*grow, H_MAX)
+
+
+'''
+WSTEP_TEMPLATE = '''@__JIT__
+def _wstep__SUFFIX__(y, P, W, h, f0, J, K, z, fz, ynew):
+    """One ROS34PW2 step (constants W_*): stage i solves
+    (I - h GAMMA J) k_i = h f(y + sum_j ALPHA_ij k_j) + h J sum_j GAMMAS_ij k_j
+    with J the Jacobian at y (_jac; the distance's row d|v|/dv; each
+    sensitivity column takes the state's block, the second derivatives of the
+    wheel forces left out, which a W-method allows). f0 = f(y); writes the
+    new state y + sum_i B_i k_i to ynew and returns the largest difference
+    from the embedded solution over the state, the local error estimate."""
+    n = y.shape[0]
+    hg = h*W_GAMMA
+    Q = _w_inverse(J, hg)
+    speed = math.sqrt(y[3]*y[3] + y[4]*y[4])
+    ex = y[3]/speed if speed > 0.0 else 0.0
+    ey = y[4]/speed if speed > 0.0 else 0.0
+    scratch = np.empty(12)
+    for i in range(4):
+        if i == 0:
+            for c in range(n):
+                fz[c] = f0[c]
+        else:
+            for c in range(n):
+                acc = y[c]
+                for j in range(i):
+                    acc += W_ALPHA[i, j]*K[j, c]
+                z[c] = acc
+            _rhs__SUFFIX__(z, P, W, fz)
+        _w_stage(K, i, fz, h, hg, J, Q, ex, ey, scratch)
+    err = 0.0
+    for c in range(n):
+        ynew[c] = y[c] + W_B[0]*K[0, c] + W_B[1]*K[1, c] + W_B[2]*K[2, c] + W_B[3]*K[3, c]
+    for c in range(6):
+        err = max(err, abs(W_E[0]*K[0, c] + W_E[1]*K[1, c] + W_E[2]*K[2, c] + W_E[3]*K[3, c]))
+    return err
+
+
+'''
+W_SOURCE = '''@__JIT__
+def _jac(y, P, W, J):
+    """J[r, c] = d(ax, ay, alpha)_r/d(psi, vx, vy, w)_c at y: the wheel
+    Jacobians summed, over m (rows ax, ay) and I (row alpha)."""
+    c = math.cos(y[2])
+    s = math.sin(y[2])
+    vx, vy, w = y[3], y[4], y[5]
+    mu, amax, eps = P[2], P[3], P[4]
+    for row in range(3):
+        for col in range(4):
+            J[row, col] = 0.0
+    for k in range(4):
+        px, py, cd, sd, n = W[k, 0], W[k, 1], W[k, 2], W[k, 3], W[k, 4]
+        b, fre, cap = W[k, 5], W[k, 6], W[k, 7]
+        if W[k, 8] != 0.0:
+            r = _wheel_locked_jac(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
+        else:
+            r = _wheel_rolling_jac(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
+        for row in range(3):
+            for col in range(4):
+                J[row, col] += r[3 + 5*row + col]
+    for col in range(4):
+        J[0, col] /= P[0]
+        J[1, col] /= P[0]
+        J[2, col] /= P[1]
+
+
+@__JIT__
+def _to_stop(y0, f0, y1, f1, t1, h, P):
+    """Cut the last step (y0, f0 at t1 - h; y1, f1 at t1) back to where the
+    speed |v| + |w| R_max falls through V_STOP (as the reference's stop event
+    does): bisection on the cubic Hermite interpolant of the step, accurate to
+    O(h^4); writes the state there into y1 and returns its time. Without it
+    the run-out would end wherever the step that crossed V_STOP ended, which
+    a long L-stable step puts up to V_STOP h further on."""
+    lo = 0.0
+    hi = 1.0
+    for _ in range(40):
+        mid = 0.5*(lo + hi)
+        a, b, c, d = _hermite(mid)
+        vx = a*y0[3] + b*h*f0[3] + c*y1[3] + d*h*f1[3]
+        vy = a*y0[4] + b*h*f0[4] + c*y1[4] + d*h*f1[4]
+        w = a*y0[5] + b*h*f0[5] + c*y1[5] + d*h*f1[5]
+        if math.sqrt(vx*vx + vy*vy) + abs(w)*P[5] < V_STOP:
+            hi = mid
+        else:
+            lo = mid
+    a, b, c, d = _hermite(hi)
+    for i in range(y1.shape[0]):
+        y1[i] = a*y0[i] + b*h*f0[i] + c*y1[i] + d*h*f1[i]
+    return t1 - h + hi*h
+
+
+@__JIT__
+def _hermite(s):
+    """Weights of y0, h f0, y1, h f1 in the cubic Hermite interpolant at s in [0, 1]."""
+    return 2.0*s**3 - 3.0*s*s + 1.0, s**3 - 2.0*s*s + s, 3.0*s*s - 2.0*s**3, s**3 - s*s
+
+
+@__JIT__
+def _stiffness(J, R):
+    """|lambda| of the state's Jacobian, estimated: the largest eigenvalue of
+    the damping block d(ax, ay, alpha)/d(vx, vy, w) by 12 power iterations (the
+    growth of the last 8, geometric mean), the yaw row and column scaled by R
+    (R_max: a similarity, so the eigenvalues stay and the start vector weighs
+    the entries alike), plus the square root of the largest scaled
+    |d(ax, ay, alpha)/d psi| (the heading's stiffness)."""
+    turn = max(abs(J[0, 0]), abs(J[1, 0]), R*abs(J[2, 0]))/R
+    x0 = 1.0
+    x1 = 1.0
+    x2 = 1.0
+    growth = 0.0
+    for k in range(12):
+        u0 = J[0, 1]*x0 + J[0, 2]*x1 + J[0, 3]*x2/R
+        u1 = J[1, 1]*x0 + J[1, 2]*x1 + J[1, 3]*x2/R
+        u2 = R*(J[2, 1]*x0 + J[2, 2]*x1) + J[2, 3]*x2
+        norm = max(abs(u0), abs(u1), abs(u2))
+        if not norm > 0.0:
+            return math.sqrt(turn)
+        if k >= 4:
+            growth += math.log(norm)
+        x0 = u0/norm
+        x1 = u1/norm
+        x2 = u2/norm
+    return math.exp(growth/8.0) + math.sqrt(turn)
+
+
+@__JIT__
+def _w_inverse(J, hg):
+    """(I - hg A - hg^2 a_psi e_w')^-1 by its adjugate, with A = J[:, 1:4] and
+    a_psi the column J[:, 0]: the velocity block of (I - hg J_state) once the
+    positions are eliminated (x, y, psi change by hg times the velocities)."""
+    M = np.empty((3, 3))
+    for r in range(3):
+        for c in range(3):
+            M[r, c] = (1.0 if r == c else 0.0) - hg*J[r, 1 + c]
+        M[r, 2] -= hg*hg*J[r, 0]
+    Q = np.empty((3, 3))
+    Q[0, 0] = M[1, 1]*M[2, 2] - M[1, 2]*M[2, 1]
+    Q[0, 1] = M[0, 2]*M[2, 1] - M[0, 1]*M[2, 2]
+    Q[0, 2] = M[0, 1]*M[1, 2] - M[0, 2]*M[1, 1]
+    Q[1, 0] = M[1, 2]*M[2, 0] - M[1, 0]*M[2, 2]
+    Q[1, 1] = M[0, 0]*M[2, 2] - M[0, 2]*M[2, 0]
+    Q[1, 2] = M[0, 2]*M[1, 0] - M[0, 0]*M[1, 2]
+    Q[2, 0] = M[1, 0]*M[2, 1] - M[1, 1]*M[2, 0]
+    Q[2, 1] = M[0, 1]*M[2, 0] - M[0, 0]*M[2, 1]
+    Q[2, 2] = M[0, 0]*M[1, 1] - M[0, 1]*M[1, 0]
+    det = M[0, 0]*Q[0, 0] + M[0, 1]*Q[1, 0] + M[0, 2]*Q[2, 0]
+    for r in range(3):
+        for c in range(3):
+            Q[r, c] /= det
+    return Q
+
+
+@__JIT__
+def _w_stage(K, i, fz, h, hg, J, Q, ex, ey, g):
+    """k_i of a ROS34PW2 stage, (I - hg J) k_i = h fz + h J sum_{j<i}
+    GAMMAS_ij k_j, block by block: the state y[0:6] with the distance (its row
+    of J: (ex, ey) = v/|v| on vx, vy), then each sensitivity column
+    y[7 + 4 r + j] (r = 0..5). The velocities' part is Q (r_v + hg a_psi r_psi),
+    the positions' r_p + hg times it."""
+    n = K.shape[1]
+    for blk in range(1 + (n - 7)//6):
+        off = 0 if blk == 0 else 6 + blk
+        st = 1 if blk == 0 else 4
+        for c in range(6):
+            acc = 0.0
+            for j in range(i):
+                acc += W_GAMMAS[i, j]*K[j, off + st*c]
+            g[c] = acc
+        for c in range(3):
+            g[6 + c] = h*(fz[off + st*c] + g[3 + c])
+            g[9 + c] = h*(fz[off + st*(3 + c)] + J[c, 0]*g[2] + J[c, 1]*g[3] + J[c, 2]*g[4] + J[c, 3]*g[5])
+            if blk == 0:
+                g[0] = h*(fz[6] + ex*g[3] + ey*g[4])  # the distance's right-hand side (g[0] is free now)
+        for c in range(3):
+            g[3 + c] = g[9 + c] + hg*J[c, 0]*g[8]
+        for c in range(3):
+            kv = Q[c, 0]*g[3] + Q[c, 1]*g[4] + Q[c, 2]*g[5]
+            K[i, off + st*(3 + c)] = kv
+            K[i, off + st*c] = g[6 + c] + hg*kv
+        if blk == 0:
+            K[i, 6] = g[0] + hg*(ex*K[i, 3] + ey*K[i, 4])
 
 
 '''
@@ -732,9 +1082,11 @@ INTEGRATOR_SOURCE = (
     .replace("__SENS__", "\n".join(line[4:] for line in _sensitivity_lines().splitlines()))
     .replace(
         "__INTEGRATE__",
-        INTEGRATE_TEMPLATE.replace("__SUFFIX__", "")
-        + "\n\n"
-        + INTEGRATE_TEMPLATE.replace("__SUFFIX__", "_sens"),
+        W_SOURCE
+        + "".join(
+            (WSTEP_TEMPLATE + "\n\n" + INTEGRATE_TEMPLATE).replace("__SUFFIX__", suffix) + "\n\n"
+            for suffix in ("", "_sens")
+        ),
     )
     .replace(
         "__ROW__",

@@ -169,3 +169,55 @@ def test_extreme_rows_run_to_rest_or_get_a_status():
     assert out["t"][0] == 0.0 and out["x_rest"][0] == BASE["x"] and out["distance"][0] == 0.0
     # a wheel that is fully braked pushes only along itself: the car still stops
     assert out["distance"][5] > 0
+
+
+@pytest.mark.parametrize("speed", [5.0, 20.0, 35.0])
+def test_a_locked_slide_ends_at_the_stopping_speed(speed):
+    """The step in which the vehicle stops is cut back to the crossing of
+    V_STOP, so the slide falls short of v^2/(2 mu g) by the travel below it,
+    V_STOP^2/(2 mu g) = 6.4e-8 m, to 1e-9 m (the step's own end, before the
+    cut-back, overshot the crossing by up to 3e-8 m)."""
+    psi = BASE["psi"]
+    y, _, status, _, _ = _one(_row(1.0, vx=speed * math.cos(psi), vy=speed * math.sin(psi)))
+    assert status == 0
+    short = (speed**2 - plain().V_STOP ** 2) / (2 * 0.8 * G)
+    assert abs(math.hypot(y[0] - 1.0, y[1] + 2.0) - short) < 1e-9
+
+
+def test_a_sticking_wheel_takes_stiff_steps():
+    """examples/runout/sedan.json: the car pivots about its locked front wheel
+    for 0.6 s with |lambda| ~ 1.2e4 1/s; explicit steps alone took 2,589 (0.25 ms
+    each), the ROS34PW2 steps take it in 611 at the default tolerance, and the
+    rest pose agrees with the tight reference."""
+    from impactsym.testing.runout_reference import reference_runout
+
+    row = _sedan_row()
+    y, _, status, steps, _ = _one(row)
+    assert status == 0 and steps < 1000
+    x, yy, psi, _, _ = reference_runout(row)
+    assert math.hypot(y[0] - x, y[1] - yy) < 1e-4 and abs(y[2] - psi) < 1e-5
+
+
+def _sedan_row() -> dict:
+    """examples/runout/sedan.json as a kernel row (a locked front wheel the car
+    pivots about, a braked rear wheel holding)."""
+    row = dict(_row(0.0, m=1450.0, I=2400.0, a=1.1, mu=0.75, x=-1.2, y=0.4, psi=math.radians(30)))
+    row.update(vx=8.0, vy=3.0, w=1.2, state_fl=1.0, brake_rl=0.5, steer_rr=math.radians(-5))
+    return row
+
+
+@pytest.mark.parametrize("tol, bound", [(1e-6, 0.02), (1e-8, 0.002)])
+def test_sensitivities_of_a_sticking_wheel_against_central_differences(tol, bound):
+    """d(x, y, psi)_rest/d(vx, vy, w) integrated with the motion against central
+    differences (1e-4) of run-outs at tol 1e-12: with explicit steps only, the
+    sensitivity equations went unstable at tol 1e-6 (relative error 1e9 on
+    b63ce3a) while the state did not."""
+    row = _sedan_row()
+    S = _one(row, tol=tol, sens=True)[0][7:].reshape(6, 4)[:3, :3]
+    fd = np.empty((3, 3))
+    for j, key in enumerate(("vx", "vy", "w")):
+        up, dn = dict(row), dict(row)
+        up[key] += 1e-4
+        dn[key] -= 1e-4
+        fd[:, j] = (_one(up, tol=1e-12)[0][:3] - _one(dn, tol=1e-12)[0][:3]) / 2e-4
+    assert np.abs(S - fd).max() < bound * np.abs(fd).max()
