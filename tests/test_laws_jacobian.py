@@ -128,17 +128,18 @@ def test_every_derivative_matches_the_50_digit_reference(model, law):
     assert skipped <= 0.02 * (checked + skipped)
 
 
-def _narrow_scene(law: str) -> dict:
+def _narrow_scene(model: str, law: str, friction: float) -> dict:
     """An eccentric car-to-car scene with narrow input distributions (the
     linear method's regime)."""
+    law_key = {"coulomb": "restitution_law", "kudlich_slibar": "contact"}[model]
     return {
-        "model": "coulomb",
+        "model": model,
         "units": "SI",
         "impact": {
             "normal_angle": {"normal": [10.0, 0.5]},
             "restitution": {"uniform": [0.29, 0.31]},
-            "friction": {"normal": [0.5, 0.01]},
-            "restitution_law": law,
+            "friction": {"normal": [friction, friction / 50]},
+            law_key: law,
         },
         "vehicles": [
             {
@@ -159,9 +160,15 @@ def _narrow_scene(law: str) -> dict:
     }
 
 
-@pytest.mark.parametrize("law", ["newton", "energetic"])
-def test_linear_sd_and_budget_agree_with_monte_carlo(law):
-    scene = _narrow_scene(law)
+@pytest.mark.parametrize(
+    "model, law, friction",
+    [("coulomb", "newton", 0.5), ("coulomb", "energetic", 0.5), ("kudlich_slibar", "sliding", 0.02)],
+)
+def test_linear_sd_and_budget_agree_with_monte_carlo(model, law, friction):
+    scene = _narrow_scene(model, law, friction)
+    if model == "kudlich_slibar":  # the sliding contact applies on this scene
+        nominal = impactsym.solve({**scene, "impact": {**scene["impact"], "friction": friction}})
+        assert nominal.mu == pytest.approx(-friction, rel=1e-12)
     u = impactsym.uncertainty(scene, draws=20_000, seed=11)
     assert u.accepted > 0.99 * u.n_draws
     for path in (
