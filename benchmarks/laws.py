@@ -1,6 +1,6 @@
 """Batch kernels of the impact laws against the memory ceiling and Brach's rigid kernel.
 
-``python -m benchmarks laws [--n 200000] [--repeat 7] [--first-use]``
+``python -m benchmarks laws [--n 200000] [--repeat 7] [--first-use] [--body-first-use]``
 
 Rows: ``impactsym.testing.laws.realistic`` (approaching passenger-car scenes with
 friction 0-1.2). Timed interleaved, the order rotating each repeat: the memory
@@ -13,6 +13,9 @@ ratios) and call time / rigid time; then the bodies on one thread (each kernel's
 through the door's runner with numba at one thread, least of 7) against Brach's
 point-impulse kernel ``rigid_em1``. ``--first-use``: the first ``solve_batch`` of a law
 (200,000 rows) in a fresh process with an empty numba cache: wall and CPU seconds.
+``--body-first-use``: the same for each law's body alone (its generated ``_<kernel>_body``
+in a one-loop ``prange`` driver: no per-row angle loop, no sincos; the batch driver
+around it is generated/'s template), against Brach's ``rigid_em1`` body.
 """
 
 from __future__ import annotations
@@ -36,6 +39,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--n", type=int, default=200_000)
     parser.add_argument("--repeat", type=int, default=7)
     parser.add_argument("--first-use", action="store_true")
+    parser.add_argument("--body-first-use", action="store_true")
 
 
 def _rows(n: int) -> dict:
@@ -87,6 +91,8 @@ def main(args) -> int:
     report["serial_ns_per_row"] = _serial(c)
     if args.first_use:
         report["first_use_s"] = _first_use()
+    if args.body_first_use:
+        report["body_first_use_s"] = _body_first_use()
     print(json.dumps(report, indent=1))
     return 0
 
@@ -159,4 +165,66 @@ def _first_use() -> dict:
         else:
             out[key] = proc.stderr
         print(f"first use {key}: {out[key]}")
+    return out
+
+
+# A one-loop prange driver around one generated body, compiled in a fresh process.
+_BODY_CODE = """
+import importlib, inspect, os, sys, time
+import numpy as np
+from impactsym.testing import laws
+module, name = sys.argv[1], sys.argv[2]
+body = getattr(importlib.import_module(module), f"_{name}_body").py_func
+args = list(inspect.signature(body).parameters)
+src = inspect.getsource(body)
+n_out = src[src.rindex("return ("):].count(",") + 1
+c = laws.realistic(270000, 1)
+c = {k: np.ascontiguousarray(v[:200000]) for k, v in c.items()}
+c.update(nx=np.cos(c["gamma"]), ny=np.sin(c["gamma"]), mu=c["mu_f"], e_m=np.ones(200000))
+outs = ", ".join(f"o{q}" for q in range(n_out))
+loop = (
+    "import math\\nfrom numba import njit, prange\\n\\n" + src + "\\n\\n"
+    "@njit(cache=True, error_model='numpy', parallel=True)\\n"
+    f"def loop({', '.join('c_' + a for a in args)}, {outs}):\\n"
+    "    for i in prange(o0.shape[0]):\\n"
+    f"        ({', '.join(f'o{q}[i]' for q in range(n_out))}) = "
+    f"_{name}_body({', '.join(f'c_{a}[i]' for a in args)})\\n"
+)
+path = os.path.join(os.environ["NUMBA_CACHE_DIR"], f"body_{name}.py")
+with open(path, "w") as fh:
+    fh.write(loop)
+sys.path.insert(0, os.environ["NUMBA_CACHE_DIR"])
+driver = importlib.import_module(f"body_{name}").loop
+arrays = [np.empty(200000) for _ in range(n_out - 2)] + [np.empty(200000, np.int32) for _ in range(2)]
+t, p = time.perf_counter(), time.process_time()
+driver(*[c[a] for a in args], *arrays)
+print(time.perf_counter() - t, time.process_time() - p)
+"""
+
+
+def _body_first_use() -> dict:
+    """Each law's body alone, and Brach's rigid_em1 body: compile and 200,000 rows
+    in a fresh process with an empty numba cache (wall and CPU seconds)."""
+    from impactsym.laws._door import LAWS, kernel
+
+    names = [("generated.planar_jit", "rigid_em1")]
+    names += [
+        (f"generated.{model}_jit", kernel(model, law).name) for model, laws in LAWS.items() for law in laws
+    ]
+    out = {}
+    for module, name in names:
+        with tempfile.TemporaryDirectory() as cache:
+            proc = subprocess.run(
+                [sys.executable, "-c", _BODY_CODE, module, name],
+                capture_output=True,
+                text=True,
+                env=dict(os.environ, NUMBA_CACHE_DIR=cache),
+                timeout=600,
+            )
+        if proc.returncode == 0:
+            wall, cpu = map(float, proc.stdout.strip().splitlines()[-1].split())
+            out[name] = {"wall_s": wall, "cpu_s": cpu, "load": os.getloadavg()[0]}
+        else:
+            out[name] = proc.stderr
+        print(f"first use of the body alone, {name}: {out[name]}")
     return out

@@ -14,6 +14,14 @@ Outputs: the value kernel's outputs, then ``d_<output>__d_<input>`` for every
 output and input (public names: ``d_mu__d_e``, ``d_TL__d_v1x``). Angles are in
 radians as in the batch columns.
 
+The impact laws (derive/kudlich_slibar.py, derive/coulomb.py) switch between
+closed forms (sliding or full contact; the Coulomb process's slip phases and
+where compression and the impact end). Their derivatives are those of the
+branch the scene takes: a slip direction sgn(gt) is constant on each side of
+gt = 0, so its DiracDelta is taken as 0; min/max of two phase lengths give a
+Heaviside (1/2 exactly at the switch, the mean of the one-sided derivatives).
+Exactly on a switch the output is continuous but not differentiable.
+
 The proofs evaluate each Jacobian kernel's formulas at random rational points
 with 50-digit arithmetic and compare every derivative output with SymPy's own
 derivative of the value kernel's output, expanded down to the inputs (the
@@ -27,7 +35,7 @@ from dataclasses import replace
 
 import sympy as sp
 
-from . import crash3, inverse, particle, planar, reconstruct
+from . import coulomb, crash3, inverse, kudlich_slibar, particle, planar, reconstruct
 from .kernel import Block, Kernel, real
 
 DIGITS = 50
@@ -108,12 +116,18 @@ def _needed_by_outputs(base: Kernel) -> set:
     return needed
 
 
+def branch_taken(derivative: sp.Expr) -> sp.Expr:
+    """A derivative on the branch a scene takes: the DiracDelta of a sign
+    switch (sgn of the slip, of an impulse) is 0 off the switch."""
+    return derivative.replace(sp.DiracDelta, lambda *args: sp.S.Zero)
+
+
 def _chain_rule(expr: sp.Expr, tangents: dict) -> dict:
     """{x: d expr/d x} through the symbols of `expr` that carry a tangent;
     derivatives that are identically zero are left out."""
     row = {}
     for s in sorted(expr.free_symbols & tangents.keys(), key=lambda q: q.name):
-        partial = sp.diff(expr, s)
+        partial = branch_taken(sp.diff(expr, s))
         if partial == 0:
             continue
         for x, ds in tangents[s].items():
@@ -123,7 +137,8 @@ def _chain_rule(expr: sp.Expr, tangents: dict) -> dict:
 
 # The kernels with derivatives: forward (given and critical μ), inverse,
 # reconstruction, CRASH3 energy (both oblique corrections: E and E_woolley are
-# outputs of the same kernel) and delta-V (energy dissipated or absorbed).
+# outputs of the same kernel), delta-V (energy dissipated or absorbed) and the
+# impact laws (Kudlich–Slibar's contacts, the Coulomb process's three ends).
 # Base (angle) form, every input.
 BASES = (
     planar.KERNELS
@@ -137,7 +152,11 @@ BASES = (
         if k.name
         in ("crash3_delta_v", "crash3_moment_arm", "crash3_radius_of_gyration", "crash3_delta_v_absorbed")
     )
+    + kudlich_slibar.KERNELS
+    + coulomb.KERNELS
 )
+# Kernels that switch between closed forms: proved on the branch each point takes.
+SWITCHING = frozenset(k.name for k in kudlich_slibar.KERNELS + coulomb.KERNELS)
 
 KERNELS = tuple(jacobian_kernel(k) for k in BASES)
 
@@ -157,6 +176,7 @@ RANGES = {
     "e": (sp.Rational(1, 10), sp.Rational(9, 10)),
     "e_m": (sp.Rational(1, 10), sp.Rational(9, 10)),
     "mu": (sp.Rational(-1, 2), sp.Rational(1, 2)),
+    "mu_f": (0, sp.Rational(6, 5)),
     "gamma": (-1, 1),
     "alpha": (sp.Rational(-7, 10), sp.Rational(7, 10)),
     "alpha1": (-1, 1),
@@ -203,23 +223,59 @@ def _sympy_gradients(base: Kernel):
     funcs = {}
     for out in base.outputs:
         formula = base.expanded(out)
-        grads = [sp.diff(formula, x) for x in base.inputs]
+        grads = [branch_taken(sp.diff(formula, x)) for x in base.inputs]
+        funcs[out] = sp.lambdify(base.inputs, grads, modules="mpmath", cse=True)
+    return funcs
+
+
+def _taken(expr: sp.Expr, values: dict) -> sp.Expr:
+    """`expr` on the branch taken at `values` (50-digit values of the inputs
+    and of every assigned symbol): Piecewise, Min, Max, sgn and |x| resolved."""
+
+    def num(a):
+        return sp.N(a.xreplace(values), DIGITS)
+
+    def piecewise(*args):
+        return next(branch for branch, cond in args if cond == sp.true or bool(cond.xreplace(values)))
+
+    expr = expr.replace(sp.Piecewise, piecewise)
+    expr = expr.replace(sp.Min, lambda *a: min(a, key=num)).replace(sp.Max, lambda *a: max(a, key=num))
+    expr = expr.replace(sp.sign, lambda a: sp.sign(num(a)))
+    return expr.replace(sp.Abs, lambda a: a if num(a) >= 0 else -a)
+
+
+def _taken_gradients(base: Kernel, values: dict):
+    """Per output, SymPy's derivatives of the output on the branch taken at
+    `values`, expanded down to the inputs (a switching kernel's expanded
+    Piecewise is too large to differentiate whole)."""
+    defs = base.definitions()
+    taken = {sym: _taken(expr, values) for sym, expr in defs.items()}
+    funcs = {}
+    for out in base.outputs:
+        formula = out
+        for sym in reversed(list(defs)):
+            formula = formula.xreplace({sym: taken[sym]})
+        grads = [branch_taken(sp.diff(formula, x)) for x in base.inputs]
         funcs[out] = sp.lambdify(base.inputs, grads, modules="mpmath", cse=True)
     return funcs
 
 
 def _agrees(knl: Kernel, base: Kernel, rng: random.Random, points: int) -> bool:
     """At `points` random points, each derivative output equals SymPy's
-    derivative of the base kernel's expanded output."""
+    derivative of the base kernel's expanded output (for a switching kernel:
+    of the branch the point takes)."""
     import mpmath
 
     checked = 0
-    gradients = _sympy_gradients(base)
+    switching = base.name in SWITCHING
+    gradients = None if switching else _sympy_gradients(base)
     for _attempt in range(50 * points):
         point = _random_point(knl, rng)
         values = _evaluate(knl, point)
         if values is None:
             continue
+        if switching:
+            gradients = _taken_gradients(base, values)
         with mpmath.workdps(DIGITS):
             args = [mpmath.mpf(point[x].p) / point[x].q for x in base.inputs]
             for out in base.outputs:
@@ -269,6 +325,11 @@ def _cap_agrees(knl: Kernel, base: Kernel, rng: random.Random) -> bool:
     return False
 
 
+def _points(base: Kernel) -> int:
+    """Proof points: more for a switching kernel (each point proves one branch)."""
+    return 4 if base.name in SWITCHING else 2
+
+
 def proofs():
     """(claim, passed): every Jacobian kernel's derivative outputs equal
     SymPy's derivatives of its value kernel's outputs at random points; the
@@ -290,9 +351,10 @@ def proofs():
         (
             (
                 f"{knl.name}: every d_output__d_input equals sympy.diff of the expanded "
-                f"{base.name} output at 2 random rational points ({DIGITS} digits)"
+                f"{base.name} output{' (the branch taken)' if base.name in SWITCHING else ''} at "
+                f"{_points(base)} random rational points ({DIGITS} digits)"
             ),
-            _agrees(knl, base, rng, points=2),
+            _agrees(knl, base, rng, points=_points(base)),
         )
         for knl, base in zip(KERNELS, BASES)
     ]

@@ -430,7 +430,7 @@ def test_solve_batch_sweep_and_sample_take_the_laws(realistic):
 
 def test_uncertainty_of_a_law_scene():
     """--uncertainty propagates a law scene's distributions through the law's batch
-    (Monte Carlo; no exact Jacobian kernel, so sd_linear is null)."""
+    (Monte Carlo) and its Jacobian kernel (sd_linear and budget: tests/test_laws_jacobian.py)."""
     from impactsym.uncertainty import uncertainty
 
     scene = {
@@ -449,7 +449,7 @@ def test_uncertainty_of_a_law_scene():
     total = u["outputs"]["energy_loss.total"]
     nominal = impactsym.solve(scene).TL
     assert total["nominal"] == nominal and total["p5"] < nominal < total["p95"]
-    assert total["sd_linear"] is None
+    assert total["sd_linear"] > 0 and abs(sum(total["budget"].values()) - 1) < 1e-12
 
 
 def test_cli_compare_and_sweep_take_a_law_scene():

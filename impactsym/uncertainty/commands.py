@@ -19,7 +19,7 @@ import numpy as np
 from .. import _kernels
 from ..batch import solve_batch
 from ..inverse import invert_batch
-from ..laws.dispatch import is_law_model
+from ..laws.dispatch import is_law_model, law_kernel
 from ..reconstruct import reconstruct_batch
 
 __all__ = ["Command", "RECONSTRUCT", "command_for", "COMMANDS", "COMPLEX_STEP"]
@@ -338,11 +338,12 @@ def command_for(
         from ..crash3 import Crash3Options
 
         return _crash3_command(units, Crash3Options(restitution, energy, correction))
-    if command == "solve" and is_law_model(model):  # impactsym.laws: no Jacobian kernel (no sd_linear)
+    if command == "solve" and is_law_model(model):  # impactsym.laws: the law's own Jacobian kernel
+        jacobian = _kernels.JACOBIAN[law_kernel(model).name]
         return Command(
             "solve",
             lambda c: _split(solve_batch(c, model=model)),
-            lambda c: (None, {}),
+            lambda c: (jacobian, {}),
             lambda c, o: _forward_outputs(c, o, True),
         )
     if command == "solve":
