@@ -16,8 +16,12 @@ from .registry import batch_kernels
 def compile_all(progress: Callable[[str], None] | None = None) -> int:
     """Compile every driver with the signatures the runtime calls it with:
     float64 C arrays in and out, int32 status and flags, and for a kernel in
-    normal form one signature per form of the normal (the angle, one normal,
-    (nx, ny) columns; the forms not given are None). Returns how many drivers."""
+    normal form the two forms of the normal a batch of real angles uses (an
+    angle per row, one normal for the batch; the forms not given are None).
+    The third, (nx, ny) columns, serves only angles beyond SINCOS_LIMIT (about
+    262,000 turns) and compiles on the first such batch: compiling it here too
+    would add half again to this command (151 s against 106 s,
+    docs/kernels.md). Returns how many drivers."""
     count = 0
     for ks in batch_kernels():
         start = time.perf_counter()
@@ -39,5 +43,5 @@ def _signatures(ks) -> list[tuple]:
     if ks.angle is None:
         return [(*columns, *outs)]
     at = ks.driver_columns.index(ks.angle)
-    forms = ((array, none, none, none), (none, none, none, array), (none, array, array, none))
+    forms = ((array, none, none, none), (none, none, none, array))
     return [(*columns[:at], *form, *columns[at + 4 :], *outs) for form in forms]
