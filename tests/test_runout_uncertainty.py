@@ -290,3 +290,35 @@ def test_what_is_not_propagated_through_the_run_out_is_one_line(capsys, tmp_path
     path.write_text(json.dumps(scene))
     err = one_line_error(capsys, "reconstruct", path, "--uncertainty", "--draws", 200)
     assert "vehicles[0].separation.mark_directions" in err
+
+
+def test_a_draws_fit_tolerance_is_a_hundredth_of_the_draws_spread_between_the_fits_and_1_mm():
+    from impactsym.runout import drawfit
+    from impactsym.runout.fit import HEADING_TOL, POSITION_TOL
+
+    J = np.diag([2.0, 2.0, 0.5])
+    rng = np.random.default_rng(3)
+    unit = rng.standard_normal((4000, 3))
+    tight = drawfit.draw_tolerances(J, 1e-5 * unit)
+    assert tight == ((POSITION_TOL, HEADING_TOL), None)  # a spread of 20 um: fit.py's tolerances
+    middle, tol = drawfit.draw_tolerances(J, 0.02 * unit)  # 4 cm and 0.01 rad of rest-pose spread
+    assert middle[0] == pytest.approx(0.01 * 0.04, rel=0.05) and tol is None
+    assert middle[1] == pytest.approx(0.01 * 0.01, rel=0.05)
+    loose = drawfit.draw_tolerances(J, 1.0 * unit)
+    assert loose == ((drawfit.DRAW_POSITION_TOL, drawfit.DRAW_HEADING_TOL), drawfit.DRAW_TOL)
+    assert drawfit.draw_tolerances(J, unit[:1]) == ((POSITION_TOL, HEADING_TOL), None)
+
+
+def test_draws_fitted_to_their_tolerances_give_the_statistics_of_tight_fits(monkeypatch):
+    """Every output's mean and percentiles with the draws' tolerances within 1 % of its sd
+    of those with fit.py's tolerances and the kernel's default integrator tolerance."""
+    from impactsym.runout import drawfit, uncertain
+
+    scene = rest_scene(wheels="locked")
+    loose = chained_uncertainty(scene, draws=2000, seed=4)[1].outputs
+    tight = ((drawfit.POSITION_TOL, drawfit.HEADING_TOL), None)
+    monkeypatch.setattr(uncertain, "draw_tolerances", lambda J, d: tight)
+    exact = chained_uncertainty(scene, draws=2000, seed=4)[1].outputs
+    for path, x in exact.items():
+        for q in ("mean", "p5", "p50", "p95"):
+            assert abs(loose[path][q] - x[q]) <= 0.01 * x["sd"] + 1e-12, (path, q)

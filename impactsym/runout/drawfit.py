@@ -16,8 +16,9 @@ grow more than GROWTH times (full, non-monotone steps: in the curved valleys
 of a spinning car a Newton step may first miss by more and then converge,
 where a descent rule crawls), and updates B by Broyden's rank-one formula.
 A row whose trial did not cut its squared miss fourfold gets a fresh B from
-forward differences of three run-outs. A row is converged at fit.py's
-tolerances (0.1 mm, 1e-5 rad). Rows still open after MAX_ITERATIONS go to
+forward differences of three run-outs. A row is converged within `draw_tolerances`:
+1 % of the draws' rest-pose spread, between fit.py's tolerances (0.1 mm,
+1e-5 rad) and 1 mm, 1e-4 rad. Rows still open after MAX_ITERATIONS go to
 fit.py's exact Newton one by one; a row that does not converge there is
 reported as not fitted.
 
@@ -45,6 +46,13 @@ STEP_SHARE, STEP_SPEED, STEP_YAW = 0.5, 2.0, 2.0  # trust region of a step (m/s,
 FAR = 0.05  # m (heading weighted by R_max): a start missing by more also tries the nominal state
 STALL = 0.25  # a trial that does not cut the squared residual by this much renews the Jacobian
 FD_SHARE = 1e-3
+# A draw's fit converges to DRAW_SHARE of the draws' rest-pose spread, at most
+# 1 mm and 1e-4 rad; its run-outs then run at tolerance DRAW_TOL, whose worst
+# rest-position error over the benchmark's random run-outs was 8.6e-5 m
+# (benchmarks/results/runout.md; 1e-6: 3.0e-3 m, more than the tolerance).
+DRAW_SHARE = 0.01
+DRAW_POSITION_TOL, DRAW_HEADING_TOL = 1e-3, 1e-4
+DRAW_TOL = 1e-7
 
 #: Why a row was not fitted (the fitted state is NaN there).
 NOT_CONVERGED = 1
@@ -71,8 +79,25 @@ def _residual(table: np.ndarray, p: np.ndarray, target: np.ndarray, tol):
     return rest - target, out["status"]
 
 
-def _done(r: np.ndarray) -> np.ndarray:
-    return (np.hypot(r[:, 0], r[:, 1]) < POSITION_TOL) & (np.abs(r[:, 2]) < HEADING_TOL)
+def _done(r: np.ndarray, tols: tuple[float, float]) -> np.ndarray:
+    return (np.hypot(r[:, 0], r[:, 1]) < tols[0]) & (np.abs(r[:, 2]) < tols[1])
+
+
+def draw_tolerances(jacobian: np.ndarray, deviations: np.ndarray) -> tuple[tuple[float, float], float | None]:
+    """((position [m], heading [rad]) to which the draws' fits converge, and the
+    integrator tolerance of their run-outs), from the nominal Jacobian
+    d(x, y, psi)_rest/d(vx, vy, w) and the rows' linear state deviations from the
+    nominal fit (rows, 3). A draw's fit only needs to be small against the spread
+    of what the draws fit: DRAW_SHARE of the rest-pose spread those deviations
+    make (J times them), between fit.py's tolerances and (DRAW_POSITION_TOL,
+    DRAW_HEADING_TOL); where the position tolerance is the loose one the run-outs
+    run at DRAW_TOL, whose error is a tenth of it."""
+    if deviations.shape[0] < 2:
+        return (POSITION_TOL, HEADING_TOL), None
+    spread = np.std(deviations @ jacobian.T, axis=0)
+    position = float(np.clip(DRAW_SHARE * min(spread[0], spread[1]), POSITION_TOL, DRAW_POSITION_TOL))
+    heading = float(np.clip(DRAW_SHARE * spread[2], HEADING_TOL, DRAW_HEADING_TOL))
+    return (position, heading), DRAW_TOL if position >= DRAW_POSITION_TOL else None
 
 
 def fit_draws(
@@ -83,13 +108,16 @@ def fit_draws(
     jacobian: np.ndarray,
     vehicle: RunoutVehicle,
     tol: float | None = None,
+    tols: tuple[float, float] = (POSITION_TOL, HEADING_TOL),
 ) -> DrawFit:
     """Fit rows of the run-out `table` (rows, COLUMNS; its vx, vy, w ignored)
     to `target` (rows, 3: x, y [m], psi [rad]) from `start` (rows, 3) or the
     `nominal` fitted state (3,), with `jacobian` (3x3, or rows x 3x3) as the
     rows' first Jacobian.
     `vehicle` is the nominal RunoutVehicle (its row layout for the exact
-    fallback)."""
+    fallback); `tol` the integrator tolerance of the run-outs (None: the
+    kernel's default), `tols` the (position [m], heading [rad]) misses within
+    which a row is fitted (`draw_tolerances`)."""
     n = table.shape[0]
     names = columns()
     a, wb, track = (table[:, names.index(c)] for c in ("a", "L", "track"))
@@ -114,7 +142,7 @@ def fit_draws(
         p[far[better]], r[far[better]], status[far[better]] = other[better], ro[better], 0
     B = np.broadcast_to(jacobian, (n, 3, 3)) * weight[:, :, None]
     failed = status != 0
-    open_ = ~failed & ~_done(r / weight)
+    open_ = ~failed & ~_done(r / weight, tols)
     for _ in range(MAX_ITERATIONS):
         rows = np.flatnonzero(open_)
         if rows.size == 0:
@@ -130,7 +158,7 @@ def fit_draws(
         take = (st == 0) & (after < GROWTH**2 * before)
         _broyden(B, rows[take], step[take], rt[take] - r[rows[take]])
         p[rows[take]], r[rows[take]] = trial[take], rt[take]
-        open_[rows[take]] = ~_done(rt[take] / weight[rows[take]])
+        open_[rows[take]] = ~_done(rt[take] / weight[rows[take]], tols)
         slow = rows[open_[rows] & ~(take & (after < STALL * before))]
         if slow.size:  # Broyden's Jacobian is not leading: differences of forward run-outs instead
             B[slow] = _differences(table[slow], p[slow], r[slow], target[slow], weight[slow], tol)

@@ -54,7 +54,7 @@ from ..uncertainty.inputs import Input
 from ..uncertainty.propagation import linear_method
 from .batch import columns, run_row, runout_batch
 from .chain import _check, _impact_part, reconstruct_from_rest
-from .drawfit import NOT_CONVERGED, fit_draws
+from .drawfit import NOT_CONVERGED, draw_tolerances, fit_draws
 from .scene import SLUG, RunoutScene, load_runout, row_values
 
 FD_TOL = 1e-10  # integrator tolerance of the central differences (docs/runout.md: error ~6e-7 m)
@@ -230,7 +230,8 @@ class Chained:
             if rows.size:
                 start = self.p[k] + dx[rows] @ self.A[k].T
                 first = self.J[k] + np.einsum("nj,jab->nab", dx[rows], self.dJ[k])
-                fit = fit_draws(table[rows], target[rows], start, self.p[k], first, vehicle)
+                tols, tol = draw_tolerances(self.J[k], start - self.p[k])
+                fit = fit_draws(table[rows], target[rows], start, self.p[k], first, vehicle, tol, tols)
                 p[rows] = fit.state
                 self.work["runouts"] += fit.runouts
                 self.work["exact_rows"] += fit.exact_rows
