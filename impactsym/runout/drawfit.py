@@ -22,10 +22,10 @@ forward differences of three run-outs. A row is converged within `draw_tolerance
 fit.py's exact Newton one by one; a row that does not converge there is
 reported as not fitted.
 
-Measured (`python -m benchmarks uncertainty --parts runout`): all wheels
-locked, 2.2 run-outs per vehicle and draw (1 for the start, 1 Newton step, a
-second for a fifth of the rows); the mixed-wheel example
-(examples/runout/chain_reconstruct_uncertain.json), whose sedan spins, about 13,
+Measured (`python -m benchmarks uncertainty --parts runout`, docs/runout.md):
+all wheels locked, 3.9 run-outs per draw (two vehicles: the start, a Newton
+step, a second for some rows); the mixed-wheel example
+(examples/runout/chain_reconstruct_uncertain.json), whose sedan spins, about 24,
 and 1-2 % of its rows go to the exact Newton.
 """
 
