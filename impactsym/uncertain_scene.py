@@ -8,8 +8,8 @@ the engine (`impactsym.uncertainty.propagation.uncertainty`).
 
 from __future__ import annotations
 
+from .runout.scene import has_runout
 from .runout.uncertain import chained_uncertainty
-from .scene import scene_data
 from .uncertainty import propagation
 from .uncertainty.result import Uncertainty
 
@@ -26,17 +26,6 @@ def uncertainty(
     distributions (conventions.md, Uncertainty); ``crash3_options``
     (``restitution``, ``energy``, ``correction``) as in
     `impactsym.uncertainty.propagation.uncertainty`."""
-    if command == "reconstruct" and _has_runout(scene):
+    if command == "reconstruct" and has_runout(scene):
         return chained_uncertainty(scene, draws, seed, sobol)[1]
     return propagation.uncertainty(scene, command, draws, seed, sobol, **crash3_options)
-
-
-def _has_runout(scene) -> bool:
-    """Whether `scene` (a path or mapping; not a parsed Scene) has a ``runout`` object."""
-    if not isinstance(scene, (str, dict)) and not hasattr(scene, "__fspath__"):
-        return False
-    try:
-        data = scene_data(scene)
-    except (OSError, ValueError):
-        return False  # the engine's own reading reports it
-    return isinstance(data, dict) and "runout" in data

@@ -63,13 +63,9 @@ def run(args: argparse.Namespace) -> int:
 def chained(args: argparse.Namespace) -> bool:
     """Whether the ``solve``/``reconstruct`` scene of `args` carries run-out data
     (a top-level ``runout`` object): then `run_chained` answers the command."""
-    from ..scene import scene_data
+    from .scene import has_runout
 
-    try:
-        data = scene_data(args.scene)
-    except (OSError, ValueError):
-        return False  # the command's own reading reports it
-    return isinstance(data, dict) and "runout" in data
+    return has_runout(args.scene)
 
 
 def run_chained(args: argparse.Namespace, command: str) -> int:

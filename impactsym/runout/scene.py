@@ -181,6 +181,19 @@ def _tyre(data: Mapping, units: str) -> dict[str, float]:
     return {"mu": mu, "alpha_max": math.radians(amax), "f_r": f_r, "g": g * (FT if units == "US" else 1.0)}
 
 
+def has_runout(scene) -> bool:
+    """Whether `scene` (a path or a mapping) has a top-level ``runout`` object,
+    so that its ``solve``/``reconstruct`` runs through the run-outs. A scene that
+    cannot be read is False: the command's own reading reports it."""
+    if not isinstance(scene, (str, Mapping)) and not hasattr(scene, "__fspath__"):
+        return False
+    try:
+        data = scene_data(scene)
+    except (OSError, ValueError):
+        return False
+    return isinstance(data, Mapping) and "runout" in data
+
+
 def load_runout(source) -> RunoutScene:
     """The run-out scene of a file path, mapping or Scene."""
     data = _mapping(scene_data(source), "scene")
