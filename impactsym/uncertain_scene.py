@@ -9,7 +9,6 @@ the engine (`impactsym.uncertainty.propagation.uncertainty`).
 from __future__ import annotations
 
 from .runout.scene import has_runout
-from .runout.uncertain import chained_uncertainty
 from .uncertainty import propagation
 from .uncertainty.result import Uncertainty
 
@@ -27,5 +26,7 @@ def uncertainty(
     (``restitution``, ``energy``, ``correction``) as in
     `impactsym.uncertainty.propagation.uncertainty`."""
     if command == "reconstruct" and has_runout(scene):
+        from .runout.uncertain import chained_uncertainty  # not at `import impactsym`
+
         return chained_uncertainty(scene, draws, seed, sobol)[1]
     return propagation.uncertainty(scene, command, draws, seed, sobol, **crash3_options)
