@@ -242,6 +242,67 @@ WHEEL_ARGS = (c, s, vx, vy, w, px, py, cd, sd, N, mu, amax, b, fre, cap, eps)
 # --- proofs --------------------------------------------------------------------
 
 
+def _rotation(d):
+    """The rotation matrix by angle d (counter-clockwise, scene frame)."""
+    return sp.Matrix([[sp.cos(d), -sp.sin(d)], [sp.sin(d), sp.cos(d)]])
+
+
+def heading_sensitivity():
+    """d(x, y, psi)_rest / d psi0 of the run-out map R(x0, y0, psi0, vx, vy, w, ...)
+    from its invariance under a rotation of the start about its centre of gravity
+    (proved in `_symbolic_claims`: the contact velocities in the wheel frames do not
+    change, so every force turns with the vehicle): turning psi0 by d and the
+    separation velocity v with it turns the rest pose by d about (x0, y0),
+        R(x0, y0, psi0 + d, Q(d) v, w) = (c0 + Q(d) (r_R - c0), psi_R + d).
+    Differentiated at d = 0, with J = dR/d(vx, vy):
+        dR/dpsi0 = (-(y_R - y0), x_R - x0, 1) - J (-vy, vx).
+    Returns (inputs, the three expressions); J's entries are Jxvx ... Jpsivy."""
+    x0, y0, xr, yr, d = sp.symbols("x0 y0 x_rest y_rest d", real=True)
+    J = sp.Matrix(3, 2, sp.symbols("J_x_vx J_x_vy J_y_vx J_y_vy J_psi_vx J_psi_vy", real=True))
+    q = _rotation(d)
+    start, rest = sp.Matrix([x0, y0]), sp.Matrix([xr, yr])
+    turned = (start + q * (rest - start)).col_join(sp.Matrix([d]))
+    dv = (q * sp.Matrix([vx, vy])).diff(d).subs(d, 0)
+    total = turned.diff(d).subs(d, 0)  # = dR/dpsi0 + J dv/dd
+    expr = [sp.simplify(e) for e in (total - J * dv)]
+    return (x0, y0, xr, yr, vx, vy, *J), expr
+
+
+def _rotation_claims():
+    """The run-out is invariant under a rotation of the start: the wheel-frame
+    contact velocities (u_l, u_s), the only way psi and v enter the wheel forces,
+    are unchanged by (psi, v) -> (psi + d, Q(d) v); and `heading_sensitivity`
+    solves the differentiated invariance for dR/dpsi0."""
+    d = sp.Symbol("d", real=True)
+    _, (ul, us) = contact_velocity()
+    v2 = _rotation(d) * sp.Matrix([vx, vy])
+    turn = {psi: psi + d, vx: v2[0], vy: v2[1]}
+    same = all(sp.simplify(sp.expand_trig(u.xreplace(turn) - u)) == 0 for u in (ul, us))
+    args, expr = heading_sensitivity()
+    x0, y0, xr, yr = args[:4]
+    J = sp.Matrix(3, 2, args[6:])
+    want = sp.Matrix([-(yr - y0), xr - x0, 1]) - J * sp.Matrix([-vy, vx])
+    solved = all(sp.simplify(a - b) == 0 for a, b in zip(expr, want))
+    return [
+        ("run-out: wheel-frame contact velocities are unchanged by turning psi and v together", same),
+        ("run-out: dR/dpsi0 = (-(y_R - y0), x_R - x0, 1) - J (-vy, vx) from that invariance", solved),
+    ]
+
+
+def heading_sensitivity_function() -> str:
+    """`rest_heading_sensitivity` as plain Python for generated/runout.py."""
+    args, expr = heading_sensitivity()
+    names = ", ".join(str(a) for a in args)
+    body = ", ".join(emit.code(e) for e in expr)
+    return (
+        f"def rest_heading_sensitivity({names}):\n"
+        '    """d(x_rest, y_rest, psi_rest)/d psi0 [m/rad, m/rad, 1] from the run-out\'s\n'
+        "    invariance under a rotation of the start about its centre of gravity\n"
+        '    (derive/runout.py `heading_sensitivity`); J_* = d(rest)/d(vx, vy) [s, s, s/m]."""\n'
+        f"    return ({body})\n"
+    )
+
+
 def _symbolic_claims():
     """Chassis identities with arbitrary wheel-frame forces (F_l, F_s): the
     scene force is the wheel force rotated by psi + delta, with norm
@@ -432,7 +493,7 @@ def _stiff_step_claims():
 
 def proofs():
     """(claim, passed) for the run-out model."""
-    return _symbolic_claims() + _numeric_claims() + _stiff_step_claims()
+    return _symbolic_claims() + _rotation_claims() + _numeric_claims() + _stiff_step_claims()
 
 
 # --- emission ------------------------------------------------------------------
@@ -542,7 +603,9 @@ def render_plain(digest: str) -> str:
     """generated/runout.py: constants, columns, outputs and status texts (plain Python)."""
     parts = [
         emit.header("runout.py", digest).rstrip("\n"),
-        "# 0 kernels, 0 arithmetic operations after common-subexpression elimination: constants only;",
+        f"# 0 kernels; rest_heading_sensitivity: {sum(sp.count_ops(e) for e in heading_sensitivity()[1])} "
+        "arithmetic operations after common-subexpression elimination;",
+        "# constants otherwise;",
         "# the wheel forces, batch driver and integrator are in generated/runout_jit.py.",
         "",
         '"""Post-impact run-out: constants, batch columns and status codes (numba code: runout_jit.py)."""',
@@ -558,6 +621,9 @@ def render_plain(digest: str) -> str:
         f"WHEELS = {WHEELS!r}",
         "GRAVITY_SI = 9.80665",
         "RIGHT_ANGLE = math.pi / 2",
+        "",
+        "",
+        heading_sensitivity_function().rstrip("\n"),
     ]
     return "\n".join(parts) + "\n"
 

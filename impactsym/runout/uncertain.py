@@ -27,7 +27,8 @@ each input x, with J = dR/dp and dR/dmu the sensitivities the kernel
 integrates, dR/d(x0, y0) the identity (the run-out does not depend on where it
 starts) and dR/dpsi0 from its invariance under rotation (rotating the start
 pose and the separation velocity about the start rotates the rest pose),
-``dR/dpsi0 = (-(y_R - y0), x_R - x0, 1) - J (-vy, vx, 0)``. The kernel has no
+``dR/dpsi0 = (-(y_R - y0), x_R - x0, 1) - J (-vy, vx, 0)``, derived and emitted as
+generated/runout.py `rest_heading_sensitivity` (derive/runout.py). The kernel has no
 sensitivities for the other run-out columns (m, I, alpha_max, f_r, brake,
 steer): those come from central differences of forward run-outs at
 `FD_TOL`, step 1 % of the input's sd. The separation states so linearised go
@@ -52,6 +53,7 @@ from ..uncertainty import Source, propagate
 from ..uncertainty.commands import RECONSTRUCT, Command
 from ..uncertainty.inputs import Input
 from ..uncertainty.propagation import linear_method
+from . import _door
 from .batch import columns, run_row, runout_batch
 from .chain import _check, _impact_part, reconstruct_from_rest
 from .drawfit import NOT_CONVERGED, draw_tolerances, fit_draws
@@ -285,7 +287,9 @@ class Chained:
             dtheta = (table[0::2] - table[1::2]) / (2 * h[:, None])
             dT = (target[0::2] - target[1::2]) / (2 * h[:, None])
             x0_, y0_ = base[0, names.index("x")], base[0, names.index("y")]
-            spsi = np.array([-(y[1] - y0_), y[0] - x0_, 1.0]) - J[:, :2] @ np.array([-p[1], p[0]])
+            spsi = np.array(
+                _door.plain().rest_heading_sensitivity(x0_, y0_, y[0], y[1], p[0], p[1], *J[:, :2].ravel())
+            )
             dR = (
                 np.outer(dtheta[:, names.index("mu")], S[:3, 3])
                 + np.outer(dtheta[:, names.index("x")], [1.0, 0.0, 0.0])
