@@ -52,6 +52,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--out", type=Path, default=Path("benchmarks/results"), help="folder for runout.md/.png/.json"
     )
     parser.add_argument("--against", metavar="REV", help="also run git revision REV's run-out (same process)")
+    parser.add_argument(
+        "--via-only",
+        action="store_true",
+        help="only the round trips with an intermediate pose (printed, nothing written)",
+    )
 
 
 class Version:
@@ -284,6 +289,59 @@ def _fit_random(n: int, version) -> dict:
     return counts
 
 
+def _fit_random_via(n: int) -> dict:
+    """Round trips with an intermediate pose (this checkout; earlier versions
+    have none): the same random run-outs as `_fit_random`, each fitted to its
+    rest pose and the pose (position and heading) at the middle accepted step
+    of its forward path. Counts fits that converged, that reported the
+    generating state (0.01 m/s, 0.01 rad/s: the evidence should choose it, not
+    merely name it), and the alternatives named."""
+    from impactsym.runout import via
+    from impactsym.runout.batch import run_row
+    from impactsym.runout.fit import fit_rest
+    from impactsym.runout.scene import RunoutVehicle
+    from tests.runout_rows import realistic_row
+
+    rng = np.random.default_rng(5)
+    counts = {"rows": n, "converged": 0, "reported_generating": 0, "alternatives": 0}
+    times = []
+    for _ in range(n):
+        row = realistic_row(rng)
+        y, _, _, _, path = run_row(
+            np.array([row[c] for c in _columns()]), path_points=via.PATH_ROWS, path_columns=8
+        )
+        mid = path[path.shape[0] // 2]
+        fixed = {k: v for k, v in row.items() if k not in ("vx", "vy", "w")}
+        veh = RunoutVehicle(
+            "r",
+            fixed,
+            (row["x"], row["y"]),
+            row["psi"],
+            None,
+            None,
+            (y[0], y[1], y[2]),
+            via=((mid[1], mid[2], mid[3]),),
+        )
+        start = time.perf_counter()
+        fit = fit_rest(veh)
+        times.append(time.perf_counter() - start)
+        counts["converged"] += fit.converged
+        counts["reported_generating"] += fit.converged and _same(fit, (row["vx"], row["vy"], row["w"]))
+        counts["alternatives"] += len(fit.alternatives)
+    counts["median_ms"] = float(np.median(times) * 1e3)
+    counts["max_ms"] = float(np.max(times) * 1e3)
+    return counts
+
+
+def _via_line(fv: dict) -> str:
+    return (
+        f"Fit round trips with an intermediate pose (checkout; the pose at the middle step of the path) on "
+        f"{fv['rows']} random realistic run-outs: {fv['converged']} converged, {fv['reported_generating']} "
+        f"reported the generating state, {fv['alternatives']} alternatives named; median {fv['median_ms']:.1f} ms, "
+        f"max {fv['max_ms']:.1f} ms per fit."
+    )
+
+
 def _same(f, p) -> bool:
     return math.hypot(f.velocity[0] - p[0], f.velocity[1] - p[1]) < 0.01 and abs(f.yaw_rate - p[2]) < 0.01
 
@@ -348,6 +406,10 @@ def main(args: argparse.Namespace) -> int:
     from impactsym.testing.runout_reference import reference_runout
     from tests.runout_rows import realistic_row
 
+    if args.via_only:
+        _fit_random_via(2)  # first use
+        print(_via_line(_fit_random_via(args.fits)))
+        return 0
     load_before = os.getloadavg()
     rng = np.random.default_rng(2024)
     rows = [realistic_row(rng) for _ in range(args.rows)]
@@ -385,6 +447,7 @@ def main(args: argparse.Namespace) -> int:
             },
             "fit": _fit_timing(versions),
             "fit_random": {v.label: _fit_random(args.fits, v) for v in versions},
+            "fit_random_via": _fit_random_via(args.fits),
             "closed_forms": _closed_forms(),
             "reference_10_rows": _reference_check(),
             "load_average": {"start": load_before, "end": os.getloadavg()},
@@ -508,4 +571,6 @@ def _markdown(r: dict) -> str:
             f"generating one; {fr['alternatives']} alternatives named, {fr['spurious_alternatives']} of them "
             f"spurious; median {fr['median_ms']:.1f} ms, max {fr['max_ms']:.1f} ms per fit."
         )
+    if "fit_random_via" in r:
+        lines.append(_via_line(r["fit_random_via"]))
     return "\n".join(lines) + "\n"

@@ -816,7 +816,9 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
     (x, y, psi, vx, vy, w) is kept below `tol` (absolute, SI) per step; the
     distance and the sensitivities ride on the same steps. The step in which
     the vehicle stops is cut back to where _speed falls through V_STOP
-    (_to_stop). Accepted points (t, x, y, psi) go to `path` while it has room.
+    (_to_stop). Accepted points go to `path` while it has room: t, then the
+    state's first path.shape[1] - 1 entries (t, x, y, psi for the drawn path;
+    the whole state with its sensitivities for the intermediate poses of a fit).
     Returns (t, status, steps, points). (The stages are a loop with one call of
     the right-hand side, not written out: numba inlines every call site, and
     seven of them tripled the compile time of first use.)"""
@@ -837,7 +839,9 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
     wait = 0  # Dormand-Prince steps before the stiffness is looked at again
     fresh = False  # J holds the Jacobian at y
     if path.shape[0] > 0:
-        path[0, 0], path[0, 1], path[0, 2], path[0, 3] = 0.0, y[0], y[1], y[2]
+        path[0, 0] = 0.0
+        for i in range(min(path.shape[1] - 1, n)):
+            path[0, 1 + i] = y[i]
         points = 1
     if _speed(y, P) < V_STOP:
         return t, STATUS_OK, steps, points
@@ -907,7 +911,9 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
         if stopped:
             t = _to_stop(y0, f0, y, k[0], t, h, P)
         if points < path.shape[0]:
-            path[points, 0], path[points, 1], path[points, 2], path[points, 3] = t, y[0], y[1], y[2]
+            path[points, 0] = t
+            for i in range(min(path.shape[1] - 1, n)):
+                path[points, 1 + i] = y[i]
             points += 1
         if stopped:
             return t, STATUS_OK, steps, points

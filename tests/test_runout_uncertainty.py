@@ -278,7 +278,7 @@ def test_a_us_scene_gives_the_si_answer_in_feet():
 
 def test_what_is_not_propagated_through_the_run_out_is_one_line(capsys, tmp_path):
     """--plot with --uncertainty, solve --uncertainty of a run-out scene, and
-    tyre-mark directions (not read by the batched fits) are refused, exit 2."""
+    tyre-mark directions and intermediate poses (not read by the batched fits) are refused, exit 2."""
     scene = rest_scene(wheels="locked")
     path = tmp_path / "rest.json"
     path.write_text(json.dumps(scene))
@@ -290,6 +290,11 @@ def test_what_is_not_propagated_through_the_run_out_is_one_line(capsys, tmp_path
     path.write_text(json.dumps(scene))
     err = one_line_error(capsys, "reconstruct", path, "--uncertainty", "--draws", 200)
     assert "vehicles[0].separation.mark_directions" in err
+    scene["vehicles"][0]["separation"] = {}
+    scene["vehicles"][0]["intermediate"] = [{"position": [1.0, 2.0]}]
+    path.write_text(json.dumps(scene))
+    err = one_line_error(capsys, "reconstruct", path, "--uncertainty", "--draws", 200)
+    assert "vehicles[0].intermediate" in err
 
 
 def test_a_draws_fit_tolerance_is_a_hundredth_of_the_draws_spread_between_the_fits_and_1_mm():

@@ -1,8 +1,9 @@
 """`runout(scene)`: each vehicle from separation to rest, as the contract's JSON.
 
 A vehicle with a full separation state runs forward (and, if it also gives
-``rest``, reports the residual against it); one that gives ``rest`` but no
-separation velocity and yaw rate has them fitted (fit.py). Results are in the
+``rest`` or ``intermediate`` poses, reports the residuals against them); one
+that gives ``rest`` but no separation velocity and yaw rate has them fitted
+(fit.py; its ``intermediate`` poses and tyre-mark directions enter the fit). Results are in the
 scene's units, angles in degrees, yaw rates in rad/s.
 """
 
@@ -11,6 +12,7 @@ from __future__ import annotations
 import math
 
 from ..errors import SceneError
+from . import via
 from .batch import columns, run_row, status_text
 from .fit import fit_rest
 from .scene import RunoutScene, RunoutVehicle, load_runout, row_values
@@ -69,21 +71,37 @@ def _vehicle(sc: RunoutScene, v: RunoutVehicle, index: int, path: bool, tol, war
             "yaw_rate": w,
         },
     }
+    residual = {}
     if v.rest is not None:
-        residual = {
-            "position": math.hypot(y[0] - v.rest[0], y[1] - v.rest[1]) / length,
-            "heading": abs(math.degrees(y[2] - v.rest[2])),
-        }
-        if fit is not None:
-            if v.marks:
-                names = {"fl": "front_left", "fr": "front_right", "rl": "rear_left", "rr": "rear_right"}
-                residual["marks"] = {names[k]: abs(math.degrees(d)) for k, d in zip(v.marks, fit.marks)}
-            entry["fit"] = {"residual": residual, "iterations": fit.iterations, "converged": fit.converged}
-        else:
-            entry["residual"] = residual
+        residual["position"] = math.hypot(y[0] - v.rest[0], y[1] - v.rest[1]) / length
+        residual["heading"] = abs(math.degrees(y[2] - v.rest[2]))
+    if v.via:
+        residual["intermediate"] = _via_misses(v, row_values(v, columns(), vx, vy, w), tol, length)
+    if fit is not None:
+        if v.marks:
+            names = {"fl": "front_left", "fr": "front_right", "rl": "rear_left", "rr": "rear_right"}
+            residual["marks"] = {names[k]: abs(math.degrees(d)) for k, d in zip(v.marks, fit.marks)}
+        entry["fit"] = {"residual": residual, "iterations": fit.iterations, "converged": fit.converged}
+    elif residual:
+        entry["residual"] = residual
     if path:
         entry["path"] = [[p[0], p[1] / length, p[2] / length, math.degrees(p[3])] for p in pts]
     return entry
+
+
+def _via_misses(v: RunoutVehicle, values, tol, length: float) -> list:
+    """Per intermediate pose, how far the run-out passes from it: ``{"position":
+    distance (scene length), "heading": deg}`` (heading only where given)."""
+    _, _, _, _, path = run_row(values, tol=tol, path_points=via.PATH_ROWS, path_columns=8)
+    r, _ = via.residuals(v.via, path, 1.0, jacobian=False)
+    out = []
+    for _, _, psi in v.via:
+        entry = {"position": math.hypot(r[0], r[1]) / length}
+        if psi is not None:
+            entry["heading"] = abs(math.degrees(r[2]))
+        out.append(entry)
+        r = r[2 if psi is None else 3 :]
+    return out
 
 
 def _unit(sc: RunoutScene) -> str:

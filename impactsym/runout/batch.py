@@ -96,12 +96,15 @@ def run_row(
     sens: bool = False,
     path_points: int = 0,
     eps: float | None = None,
+    path_columns: int = 4,
 ):
     """One row (the COLUMNS values): (y, t, status, steps, path). y = (x, y, psi,
     vx, vy, w, distance) at rest, then with `sens` d y_i/d(vx, vy, w, mu) at
-    y[7 + 4 i + j]; `path` is (points, 4) of (t, x, y, psi) when asked."""
+    y[7 + 4 i + j]; `path` is (points, path_columns) when asked: t, then the
+    first path_columns - 1 entries of y at each accepted step (t, x, y, psi by
+    default; 1 + len(y) for the whole state, as via.py reads it)."""
     plain, jit = _door.plain(), _door.jit()
-    buffer = np.empty((path_points, 4))
+    buffer = np.empty((path_points, path_columns))
     row = jit.runout_row_sens if sens else jit.runout_row
     y, t, status, steps, points = row(
         np.ascontiguousarray(values, dtype=np.float64),

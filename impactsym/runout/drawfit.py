@@ -230,4 +230,5 @@ def _variant(vehicle: RunoutVehicle, row: np.ndarray, target: np.ndarray) -> Run
         heading=values["psi"],
         rest=tuple(float(x) for x in target),
         marks={},
+        via=(),
     )

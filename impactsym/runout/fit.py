@@ -31,15 +31,24 @@ every alternative in the warnings is a separation state that reaches the rest
 pose within the tolerances, and no two are the same state. The reported state
 is the one nearest the estimate; the others are its `alternatives`. The search
 is not exhaustive: a state no start leads to is not named.
+
+Further evidence (least squares over all rows, Levenberg-Marquardt as above):
+the direction of a wheel's tyre mark at separation (`_mark_rows`) and poses the
+vehicle passed through between separation and rest (via.py: the path's point
+nearest a given position, and its heading). With such evidence the fit starts
+from every state found that reaches the rest pose alone (`_fit_evidence`); the
+reported state is the one with the least squared residual, and another is named
+only if its squared residual is within EVIDENCE_COST_SHARE of that.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from . import via
 from .batch import columns, run_row, runout_batch
 from .scene import RunoutVehicle, row_values
 
@@ -69,6 +78,12 @@ UNIQUE_COARSE = 1000.0
 POLISH_BUDGET = 12
 DEFLATION_SCALE = np.array([0.5, 0.5, 0.2])  # m/s, m/s, rad/s: the reach of the deflation
 COARSE = 100.0  # Newton's first stage stops at COARSE x (POSITION_TOL, HEADING_TOL)
+# With marks or intermediate poses the fit is least squares: the state with the
+# least squared residual is reported, and another state found is named only if
+# its squared residual is within EVIDENCE_COST_SHARE times that (its misses at
+# most twice as large) or within the tolerance per row: a state that reaches
+# the rest pose but misses the other evidence is no alternative.
+EVIDENCE_COST_SHARE = 4.0
 
 
 @dataclass
@@ -86,6 +101,10 @@ class Fit:
     marks: list = field(
         default_factory=list
     )  # residuals of the mark directions [rad], in vehicle.marks order
+    via: list = field(
+        default_factory=list
+    )  # per intermediate pose: (position miss [m], heading miss [rad] or None)
+    cost: float = math.inf  # squared norm of the weighted residual (rest, marks, poses)
 
 
 def _wheel_table(row: dict):
@@ -120,20 +139,37 @@ def starting_estimate(vehicle: RunoutVehicle) -> tuple[float, float, float]:
 
 
 def _evaluate(vehicle, cols, p, tol):
-    """(residual vector, Jacobian) at p = (vx, vy, w); residual None if the run fails."""
-    y, _, status, _, _ = run_row(row_values(vehicle, cols, *p), tol=tol, sens=True)
-    if status != 0:
+    """(residual vector, Jacobian) at p = (vx, vy, w); residual None if the run
+    fails. Rows: the rest pose (x, y, psi times R_max), the mark directions,
+    the intermediate poses (via.py)."""
+    points = via.PATH_ROWS if vehicle.via else 0
+    y, _, status, _, path = run_row(
+        row_values(vehicle, cols, *p), tol=tol, sens=True, path_points=points, path_columns=via.PATH_COLUMNS
+    )
+    if status != 0 or (points and path.shape[0] >= points):  # failed, or more steps than the path holds
         return None, None
-    x_r, y_r, psi_r = vehicle.rest
     scale = _radius(vehicle.row)
-    r = np.array([y[0] - x_r, y[1] - y_r, (y[2] - psi_r) * scale])
+    r = _rest_rows(vehicle, y, scale)
     S = y[7:].reshape(6, 4)
     J = S[:3, :3].copy()
     J[2] *= scale
     if vehicle.marks:
         rm, Jm = _mark_rows(vehicle, p, scale)
         r, J = np.concatenate([r, rm]), np.vstack([J, Jm])
+    if vehicle.via:
+        rv, Jv = via.residuals(vehicle.via, path, scale, jacobian=True)
+        r, J = np.concatenate([r, rv]), np.vstack([J, Jv])
     return r, J
+
+
+def _via_misses(vehicle: RunoutVehicle, r, scale: float) -> list:
+    """(position miss [m], heading miss [rad] or None) per intermediate pose,
+    from the pose rows at the end of the residual vector."""
+    rows, out = r[3 + len(vehicle.marks) :], []
+    for _, _, psi in vehicle.via:
+        out.append((math.hypot(rows[0], rows[1]), None if psi is None else abs(rows[2]) / scale))
+        rows = rows[2 if psi is None else 3 :]
+    return out
 
 
 def _mark_rows(vehicle: RunoutVehicle, p, scale: float):
@@ -162,9 +198,13 @@ def _radius(row) -> float:
 
 
 def _done(r, scale, coarse: float = 1.0) -> bool:
-    """The residual within `coarse` times (POSITION_TOL, HEADING_TOL)."""
+    """The residual within `coarse` times (POSITION_TOL, HEADING_TOL), and each
+    row of further evidence (marks, intermediate poses; metres, or radians
+    times `scale`) within `coarse` times POSITION_TOL: a least-squares fit that
+    cannot meet them all ends where its steps stop lowering the residual."""
     k = coarse
-    return math.hypot(r[0], r[1]) < k * POSITION_TOL and abs(r[2]) / scale < k * HEADING_TOL
+    rest = math.hypot(r[0], r[1]) < k * POSITION_TOL and abs(r[2]) / scale < k * HEADING_TOL
+    return rest and bool(np.all(np.abs(r[3:]) < k * POSITION_TOL))
 
 
 def newton(vehicle: RunoutVehicle, start, tol: float | None = None, budget: int = MAX_ITERATIONS) -> Fit:
@@ -233,7 +273,9 @@ def _newton(vehicle: RunoutVehicle, start, tol, budget: int, coarse: float = 1.0
         iterations,
         bool(_done(r, scale, coarse) or stalled),
         tuple(start),
-        marks=[float(x) / scale for x in r[3:]],
+        marks=[float(x) / scale for x in r[3 : 3 + len(vehicle.marks)]],
+        via=_via_misses(vehicle, r, scale),
+        cost=float(r @ r),
     )
 
 
@@ -248,15 +290,40 @@ def _yaw_candidates(w: float) -> list[float]:
 
 def _scan(vehicle: RunoutVehicle, estimate, tol) -> list:
     """Candidate starts around the estimate, best residual first: speed x
-    SPEED_SCALES, each yaw rate of `_yaw_candidates`, run forward in one batch."""
+    SPEED_SCALES, each yaw rate of `_yaw_candidates`, run forward in one batch
+    (one by one with their paths when the vehicle has intermediate poses, whose
+    misses then count in the ranking as the tyre-mark directions' do)."""
     cols, scale = columns(), _radius(vehicle.row)
     vx, vy, w = estimate
-    x_r, y_r, psi_r = vehicle.rest
     starts = [(vx * sv, vy * sv, yaw) for sv in SPEED_SCALES for yaw in _yaw_candidates(w)]
     table = np.stack([row_values(vehicle, cols, *p) for p in starts])
-    out = runout_batch(dict(zip(cols, table.T)), tol=tol, parallel=False)
-    res = np.hypot(np.hypot(out["x_rest"] - x_r, out["y_rest"] - y_r), (out["psi_rest"] - psi_r) * scale)
-    return [starts[i] for i in np.argsort(res, kind="stable") if out["status"][i] == 0]
+    if vehicle.via:
+        misses = [_forward_miss(vehicle, values, tol, scale) for values in table]
+    else:
+        out = runout_batch(dict(zip(cols, table.T)), tol=tol, parallel=False)
+        rest = np.column_stack([out["x_rest"], out["y_rest"], out["psi_rest"]])
+        misses = [_rest_rows(vehicle, y, scale) if s == 0 else None for y, s in zip(rest, out["status"])]
+    res = [np.inf if m is None else float(m @ m) for m in misses]
+    if vehicle.marks:
+        res = [
+            r + float(_mark_rows(vehicle, p, scale)[0] @ _mark_rows(vehicle, p, scale)[0])
+            for r, p in zip(res, starts)
+        ]
+    return [starts[i] for i in np.argsort(res, kind="stable") if math.isfinite(res[i])]
+
+
+def _rest_rows(vehicle: RunoutVehicle, y, scale: float) -> np.ndarray:
+    """Rest-pose residual (x, y, psi times `scale`) of a state at rest y."""
+    x_r, y_r, psi_r = vehicle.rest
+    return np.array([y[0] - x_r, y[1] - y_r, (y[2] - psi_r) * scale])
+
+
+def _forward_miss(vehicle: RunoutVehicle, values, tol, scale: float):
+    """Rest-pose and intermediate-pose residuals of one forward run-out (None if it fails)."""
+    y, _, status, _, path = run_row(values, tol=tol, path_points=via.PATH_ROWS, path_columns=8)
+    if status != 0 or path.shape[0] >= via.PATH_ROWS:
+        return None
+    return np.concatenate([_rest_rows(vehicle, y, scale), via.residuals(vehicle.via, path, scale, False)[0]])
 
 
 def _diverse(starts: list, count: int) -> list:
@@ -278,7 +345,42 @@ def fit_rest(vehicle: RunoutVehicle, tol: float | None = None, check_unique: boo
     more; with `check_unique`, the diverse starts left after the first
     converged one run as the uniqueness check, and the other separation states
     found that reach the rest pose (polished to the full tolerances, distinct
-    from each other) are attached as `alternatives` (module docstring)."""
+    from each other) are attached as `alternatives` (module docstring).
+    With tyre-mark directions or intermediate poses, see `_fit_evidence`."""
+    if vehicle.marks or vehicle.via:
+        return _fit_evidence(vehicle, tol, check_unique)
+    return _search(vehicle, tol, check_unique)
+
+
+def _fit_evidence(vehicle: RunoutVehicle, tol, check_unique: bool) -> Fit:
+    """Least squares over the rest pose and the further evidence, from every
+    separation state that reaches the rest pose alone (the rest-only fit and
+    its alternatives: each is a basin the evidence may choose; started from
+    the scan instead, every start of seed-5 row 1 fell into the basin of the
+    state that misses its intermediate pose by 9 cm). Where none of them meets
+    the evidence (or none is found), the search also runs on the whole
+    residual (`_search`) and the least squared residual of all is reported."""
+    plain = _search(replace(vehicle, marks={}, via=()), tol, check_unique=True)
+    found: list[Fit] = []
+    for root in (plain, *plain.alternatives) if plain.converged else ():
+        f = newton(vehicle, (*root.velocity, root.yaw_rate), tol)
+        if f.converged and all(_distinct(f, g) for g in found):
+            f.iterations += root.iterations
+            found.append(f)
+    if not any(_meets(vehicle, f) for f in found):  # no rest-pose state meets the evidence: search it all
+        other = _search(vehicle, tol, check_unique)
+        if not found:
+            return other
+        if other.converged and all(_distinct(other, g) for g in found):
+            found.append(other)
+    best = min(found, key=lambda f: f.cost)
+    bound = EVIDENCE_COST_SHARE * best.cost + _rows(vehicle) * POSITION_TOL**2
+    best.alternatives = [f for f in found if f is not best and f.cost <= bound] if check_unique else []
+    return best
+
+
+def _search(vehicle: RunoutVehicle, tol, check_unique: bool) -> Fit:
+    """The scan, the Newton starts and the uniqueness check of `fit_rest`."""
     estimate = starting_estimate(vehicle)
     starts = _scan(vehicle, estimate, LOOSE_TOL) or [estimate]
     diverse = _diverse(starts, UNIQUE_STARTS)
@@ -300,10 +402,30 @@ def fit_rest(vehicle: RunoutVehicle, tol: float | None = None, check_unique: boo
                     found.append(polished)
     if not found:
         return first
+    if vehicle.marks or vehicle.via:  # least squares: the state that fits the evidence best
+        best = min(found, key=lambda f: f.cost)
+        bound = EVIDENCE_COST_SHARE * best.cost + _rows(vehicle) * POSITION_TOL**2
+        best.alternatives = [f for f in found if f is not best and f.cost <= bound]
+        return best
     est = np.array(estimate)
     best = min(found, key=lambda f: _distance(f, est))
     best.alternatives = [f for f in found if f is not best]
     return best
+
+
+def _rows(vehicle: RunoutVehicle) -> int:
+    """Residual rows of a fit: the rest pose, the marks, the intermediate poses."""
+    return 3 + len(vehicle.marks) + sum(2 if psi is None else 3 for *_, psi in vehicle.via)
+
+
+def _meets(vehicle: RunoutVehicle, f: Fit) -> bool:
+    """`f` converged and, with further evidence, meets all of it (a squared
+    residual within the position tolerance per row): a least-squares minimum
+    that leaves part of the evidence unmet may be another start's basin, so
+    the further starts are tried (the best of all is reported)."""
+    if not (vehicle.marks or vehicle.via):
+        return f.converged
+    return f.converged and f.cost <= _rows(vehicle) * POSITION_TOL**2
 
 
 def _distance(f: Fit, est) -> float:

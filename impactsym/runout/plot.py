@@ -1,6 +1,7 @@
 """`--plot`: the run-out paths with vehicle outlines at intervals, tyre marks
 as the traces of the locked wheels, the separation and rest poses, and the
-measured rest pose when the scene gives one (matplotlib, imported here only)."""
+measured rest pose and intermediate poses when the scene gives them
+(matplotlib, imported here only)."""
 
 from __future__ import annotations
 
@@ -46,6 +47,7 @@ def plot_runout(scene: RunoutScene, result: dict, out: str) -> None:
         if veh.rest is not None:
             pts = _outline(veh.row, veh.rest[0] / length, veh.rest[1] / length, veh.rest[2], length)
             ax.plot(pts[:, 0], pts[:, 1], color="k", lw=1, ls="--", label=f"{entry['name']} measured rest")
+        _intermediate(ax, veh, entry["name"], length)
     unit = "ft" if scene.units == "US" else "m"
     ax.set_xlabel(f"x [{unit}]")
     ax.set_ylabel(f"y [{unit}]")
@@ -70,3 +72,14 @@ def _tyre_marks(ax, veh, x, y, psi, length) -> None:
             wx = x + (np.cos(psi) * px - np.sin(psi) * py) / length
             wy = y + (np.sin(psi) * px + np.cos(psi) * py) / length
             ax.plot(wx, wy, color="0.2", lw=2.5, alpha=0.6)
+
+
+def _intermediate(ax, veh, name: str, length: float) -> None:
+    """The given intermediate poses: a cross at each position, the outline
+    where a heading is given."""
+    for i, (x, y, psi) in enumerate(veh.via):
+        label = f"{name} intermediate poses" if i == 0 else None
+        ax.plot(x / length, y / length, "kx", ms=8, label=label)
+        if psi is not None:
+            pts = _outline(veh.row, x / length, y / length, psi, length)
+            ax.plot(pts[:, 0], pts[:, 1], color="k", lw=0.8, ls=":")

@@ -60,6 +60,7 @@ VEHICLE_KEYS = (
     "wheels",
     "separation",
     "rest",
+    "intermediate",
     "impact_point",
     "friction",
     *IMPACT_VEHICLE_KEYS,
@@ -68,6 +69,7 @@ WHEEL_NAMES = ("front_left", "front_right", "rear_left", "rear_right")
 WHEEL_KEYS = ("state", "brake", "steer")
 SEPARATION_KEYS = ("position", "heading", "velocity", "yaw_rate", "mark_directions")
 REST_KEYS = ("position", "heading")
+INTERMEDIATE_KEYS = ("position", "heading")
 
 
 @dataclass
@@ -87,6 +89,7 @@ class RunoutVehicle:
     marks: dict = field(
         default_factory=dict
     )  # wheel key (fl, fr, rl, rr) -> mark direction at separation [rad]
+    via: tuple = ()  # intermediate poses passed through: (x, y [m], psi [rad] or None) each
 
     @property
     def fitted(self) -> bool:
@@ -244,6 +247,7 @@ def _vehicle(v: Mapping, index: int, tyre: dict, centre, units: str, length: flo
     velocity = _pair(sep["velocity"], f"{p}.separation.velocity") if has_v else None
     yaw_rate = _number(sep["yaw_rate"], f"{p}.separation.yaw_rate") if has_w else None
     marks = _marks(sep.get("mark_directions", {}), f"{p}.separation.mark_directions")
+    via = _intermediate(v.get("intermediate", []), f"{p}.intermediate", length)
     rest = None
     if "rest" in v:
         r = _mapping(v["rest"], f"{p}.rest")
@@ -289,7 +293,25 @@ def _vehicle(v: Mapping, index: int, tyre: dict, centre, units: str, length: flo
         rest=rest,
         wheels=wheels,
         marks=marks,
+        via=via,
     )
+
+
+def _intermediate(value: Any, path: str, length: float) -> tuple:
+    """``intermediate``: a list of poses the vehicle passed through between
+    separation and rest, each ``{"position": [x, y], "heading": deg}`` (the
+    heading optional; total heading, as ``rest.heading``), as (x, y [m], psi
+    [rad] or None) tuples."""
+    if not isinstance(value, list):
+        raise SceneError(f"must be a list of poses {{position, heading}}, got {show_value(value)}", path)
+    poses = []
+    for i, raw in enumerate(value):
+        entry = _mapping(raw, f"{path}[{i}]")
+        check_keys(entry, INTERMEDIATE_KEYS, f"{path}[{i}]")
+        x, y = _pair(_require(entry, "position", f"{path}[{i}]"), f"{path}[{i}].position")
+        psi = math.radians(_number(entry["heading"], f"{path}[{i}].heading")) if "heading" in entry else None
+        poses.append((x * length, y * length, psi))
+    return tuple(poses)
 
 
 def _marks(value: Any, path: str) -> dict[str, float]:

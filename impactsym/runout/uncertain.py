@@ -377,14 +377,16 @@ def nominal_data(scene) -> tuple[dict, dict, dict]:
         load_runout(data)  # names what is wrong
     leaves = _nominal_leaves(data, data["units"])
     for i, v in enumerate(data.get("vehicles") or []):
-        if (
-            isinstance(v, dict)
-            and isinstance(v.get("separation"), dict)
-            and v["separation"].get("mark_directions")
-        ):
+        if not isinstance(v, dict):
+            continue
+        if isinstance(v.get("separation"), dict) and v["separation"].get("mark_directions"):
             raise SceneError(
                 "not read by --uncertainty through the run-out (leave it out)",
                 f"vehicles[{i}].separation.mark_directions",
+            )
+        if v.get("intermediate"):
+            raise SceneError(
+                "not read by --uncertainty through the run-out (leave it out)", f"vehicles[{i}].intermediate"
             )
     if len(_check(data)) != len(data["vehicles"]):
         reconstruct_from_rest(data)  # names the vehicle without run-out data
