@@ -1168,6 +1168,8 @@ INTEGRATOR_SOURCE = (
         .replace("__SINIT__", "")
         + "\n\n"
         + ROW_TEMPLATE.replace("__SUFFIX__", "_sens")
+        # nogil: the fit runs its uniqueness starts on threads (impactsym/runout/fit.py)
+        .replace("@__JIT__", "@" + JIT[:-1] + ", nogil=True)")
         .replace("__N__", "31")
         .replace(
             "__DOC__",

@@ -101,30 +101,37 @@ def run_row(
     """One row (the COLUMNS values): (y, t, status, steps, path). y = (x, y, psi,
     vx, vy, w, distance) at rest, then with `sens` d y_i/d(vx, vy, w, mu) at
     y[7 + 4 i + j]; `path` is (points, path_columns) when asked: t, then the
-    first path_columns - 1 entries of y at each accepted step (t, x, y, psi by
-    default; 1 + len(y) for the whole state, as via.py reads it)."""
+    first path_columns - 1 entries of the state at each accepted step (t, x, y,
+    psi by default; 32 for the whole state with its sensitivities, as via.py
+    reads it).
+
+    Every single run-out of a scene (forward, fitted, drawn) goes through the
+    one row function with sensitivities, `sens` only choosing what is returned:
+    a scene's first use then compiles one integrator, not two (a first fit
+    scene on an empty cache 5.3 s instead of 7.6 s, docs/runout.md). Its
+    forward part is the forward kernel's model on its own error control; the
+    two differ by round-off that the adaptive steps carry (worst 0.36 mm over
+    300 random run-outs, within the integrator's error). Batches use the
+    forward drivers (`runout_batch`)."""
     plain, jit = _door.plain(), _door.jit()
     buffer = np.empty((path_points, path_columns))
-    row = jit.runout_row_sens if sens else jit.runout_row
-    y, t, status, steps, points = row(
+    y, t, status, steps, points = jit.runout_row_sens(
         np.ascontiguousarray(values, dtype=np.float64),
         plain.TOL if tol is None else float(tol),
         plain.EPS if eps is None else float(eps),
         buffer,
     )
-    return y, t, int(status), int(steps), buffer[:points]
+    return (y if sens else y[:7]), t, int(status), int(steps), buffer[:points]
 
 
 def compile_drivers() -> int:
     """Compile (or load from numba's cache) every run-out driver: both batch
-    drivers and the row functions with and without sensitivities, by running
+    drivers and the row function with sensitivities (`run_row`'s), by running
     one locked slide through each (``impactsym compile``). Returns how many."""
     row = {"m": 1500.0, "I": 2500.0, "L": 2.7, "a": 1.2, "track": 1.5, "mu": 0.7}
     row |= {"x": 0.0, "y": 0.0, "psi": 0.0, "vx": 10.0, "vy": 0.0, "w": 0.0}
     row |= {f"state_{k}": 1.0 for k in ("fl", "fr", "rl", "rr")}
     for parallel in (True, False):
         runout_batch(row, parallel=parallel)
-    values = input_table(row)[0]
-    for sens in (False, True):
-        run_row(values, sens=sens)
-    return 4
+    run_row(input_table(row)[0], sens=True)
+    return 3

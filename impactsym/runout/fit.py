@@ -15,16 +15,19 @@ wheels' mean longitudinal coefficient (mu locked, b mu braked, f_r rolling,
 weighted by load) blended toward mu as the rotation grows to 90 deg (a
 rotating vehicle slides its rolling wheels sideways).
 
-Starts: the estimate is refined by a scan of forward run-outs in one batch
-(speed x 0.7, 1, 1.3; yaw rate x 1, 0.5, 0, -0.5, -1, 1.5, and +-1 rad/s when
-the estimate is below 0.5 rad/s); Newton starts from the candidate nearest the
-rest pose; if it does not converge, from the next three candidates whose yaw
-rates differ by more than 0.3 rad/s from those already taken, then from up to
-four further candidates, in turn. Uniqueness: Newton also runs, to COARSE x
-the tolerances, from those three diverse candidates left after the first start
-that converged; a run is abandoned as soon as an iterate comes within the
-distinctness thresholds (0.05 m/s, 0.02 rad/s) of a state already found (it is
-heading for that one). A run that converges to a state not yet found is
+Starts: the estimate is refined by a scan of forward run-outs (speed x 0.7,
+1, 1.3; yaw rate x 1, 0.5, 0, -0.5, -1, 1.5, and +-1 rad/s when the estimate
+is below 0.5 rad/s); Newton starts from the candidate nearest the rest pose;
+if it does not converge, from the next three candidates whose yaw rates
+differ by more than 0.3 rad/s from those already taken, then from up to four
+further candidates, in turn. Uniqueness: Newton also runs, to COARSE x the
+tolerances, from those three diverse candidates left after the first start
+that converged, deflated away from the state found; a run is abandoned as
+soon as an iterate comes within the distinctness thresholds (0.05 m/s, 0.02
+rad/s) of it (it is heading for that one). The scan's run-outs and the
+uniqueness starts run on threads (`_pool`; the row function releases the
+GIL), so the starts do not deflate each other's states: two that find the
+same new state name it once. A run that converges to a state not yet found is
 polished by Newton to the full tolerances and named only if the polished state
 still reaches the rest pose and is still distinct from every state found:
 every alternative in the warnings is a separation state that reaches the rest
@@ -43,13 +46,16 @@ only if its squared residual is within EVIDENCE_COST_SHARE of that.
 
 from __future__ import annotations
 
+import functools
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from . import via
-from .batch import columns, run_row, runout_batch
+from .batch import columns, run_row
 from .scene import RunoutVehicle, row_values
 
 MAX_ITERATIONS = 40
@@ -290,25 +296,20 @@ def _yaw_candidates(w: float) -> list[float]:
 
 def _scan(vehicle: RunoutVehicle, estimate, tol) -> list:
     """Candidate starts around the estimate, best residual first: speed x
-    SPEED_SCALES, each yaw rate of `_yaw_candidates`, run forward in one batch
-    (one by one with their paths when the vehicle has intermediate poses, whose
-    misses then count in the ranking as the tyre-mark directions' do)."""
+    SPEED_SCALES, each yaw rate of `_yaw_candidates`, each run forward (through
+    `run_row`, the scene's one row function; with intermediate poses their
+    misses count in the ranking, as the tyre-mark directions' do)."""
     cols, scale = columns(), _radius(vehicle.row)
     vx, vy, w = estimate
     starts = [(vx * sv, vy * sv, yaw) for sv in SPEED_SCALES for yaw in _yaw_candidates(w)]
-    table = np.stack([row_values(vehicle, cols, *p) for p in starts])
-    if vehicle.via:
-        misses = [_forward_miss(vehicle, values, tol, scale) for values in table]
-    else:
-        out = runout_batch(dict(zip(cols, table.T)), tol=tol, parallel=False)
-        rest = np.column_stack([out["x_rest"], out["y_rest"], out["psi_rest"]])
-        misses = [_rest_rows(vehicle, y, scale) if s == 0 else None for y, s in zip(rest, out["status"])]
-    res = [np.inf if m is None else float(m @ m) for m in misses]
-    if vehicle.marks:
-        res = [
-            r + float(_mark_rows(vehicle, p, scale)[0] @ _mark_rows(vehicle, p, scale)[0])
-            for r, p in zip(res, starts)
-        ]
+
+    def miss2(p) -> float:
+        miss = _forward_miss(vehicle, row_values(vehicle, cols, *p), tol, scale)
+        if miss is not None and vehicle.marks:
+            miss = np.concatenate([miss, _mark_rows(vehicle, p, scale)[0]])
+        return math.inf if miss is None else float(miss @ miss)
+
+    res = list(_pool().map(miss2, starts))
     return [starts[i] for i in np.argsort(res, kind="stable") if math.isfinite(res[i])]
 
 
@@ -319,11 +320,13 @@ def _rest_rows(vehicle: RunoutVehicle, y, scale: float) -> np.ndarray:
 
 
 def _forward_miss(vehicle: RunoutVehicle, values, tol, scale: float):
-    """Rest-pose and intermediate-pose residuals of one forward run-out (None if it fails)."""
-    y, _, status, _, path = run_row(values, tol=tol, path_points=via.PATH_ROWS, path_columns=8)
-    if status != 0 or path.shape[0] >= via.PATH_ROWS:
+    """Rest-pose residuals (and the intermediate poses') of one forward run-out; None if it fails."""
+    points = via.PATH_ROWS if vehicle.via else 0
+    y, _, status, _, path = run_row(values, tol=tol, path_points=points, path_columns=8)
+    if status != 0 or (points and path.shape[0] >= points):
         return None
-    return np.concatenate([_rest_rows(vehicle, y, scale), via.residuals(vehicle.via, path, scale, False)[0]])
+    rows = _rest_rows(vehicle, y, scale)
+    return np.concatenate([rows, via.residuals(vehicle.via, path, scale, False)[0]]) if vehicle.via else rows
 
 
 def _diverse(starts: list, count: int) -> list:
@@ -388,18 +391,16 @@ def _search(vehicle: RunoutVehicle, tol, check_unique: bool) -> Fit:
     found: list[Fit] = []
     first = None
     for i, start in enumerate([starts[0], *diverse, *rescue]):
-        if not found:  # Newton to the full tolerances until a start converges
-            f = newton(vehicle, start, tol)
-            first = first or f
-            if f.converged:
-                found.append(f)
-        elif check_unique and i <= len(diverse):
-            f = _newton(vehicle, start, UNIQUE_TOL, UNIQUE_BUDGET, coarse=UNIQUE_COARSE, known=found)
-            if f.converged and all(_distinct(f, g) for g in found):
-                polished = newton(vehicle, (*f.velocity, f.yaw_rate), tol, POLISH_BUDGET)
-                if polished.converged and all(_distinct(polished, g) for g in found):
-                    polished.iterations += f.iterations
-                    found.append(polished)
+        f = newton(vehicle, start, tol)  # Newton to the full tolerances until a start converges
+        first = first or f
+        if f.converged:
+            found.append(f)
+            if check_unique:
+                unique = functools.partial(_unique, vehicle, tol=tol, known=list(found))
+                for g in _pool().map(unique, diverse[i:]):
+                    if g is not None and all(_distinct(g, h) for h in found):
+                        found.append(g)
+            break
     if not found:
         return first
     if vehicle.marks or vehicle.via:  # least squares: the state that fits the evidence best
@@ -411,6 +412,30 @@ def _search(vehicle: RunoutVehicle, tol, check_unique: bool) -> Fit:
     best = min(found, key=lambda f: _distance(f, est))
     best.alternatives = [f for f in found if f is not best]
     return best
+
+
+def _unique(vehicle: RunoutVehicle, start, *, tol, known: list) -> Fit | None:
+    """A uniqueness start: deflated Newton from `start` away from the `known`
+    states, then polished to the full tolerances; the state if it converges
+    and is distinct from the known ones, else None."""
+    f = _newton(vehicle, start, UNIQUE_TOL, UNIQUE_BUDGET, coarse=UNIQUE_COARSE, known=known)
+    if not (f.converged and all(_distinct(f, g) for g in known)):
+        return None
+    polished = newton(vehicle, (*f.velocity, f.yaw_rate), tol, POLISH_BUDGET)
+    if not (polished.converged and all(_distinct(polished, g) for g in known)):
+        return None
+    polished.iterations += f.iterations
+    return polished
+
+
+@functools.cache
+def _pool() -> ThreadPoolExecutor:
+    """The threads of the scan and the uniqueness starts (one per CPU, at most
+    four): they run independent run-outs, and the row function releases the
+    GIL (nogil), so they share out the fit's run-outs."""
+    return ThreadPoolExecutor(
+        max_workers=max(1, min(4, os.cpu_count() or 1)), thread_name_prefix="impactsym-fit"
+    )
 
 
 def _rows(vehicle: RunoutVehicle) -> int:
