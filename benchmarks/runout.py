@@ -101,8 +101,42 @@ def _versions(rev: str | None, folder: Path) -> list:
         module = importlib.util.module_from_spec(spec)
         sys.modules[name] = module
         spec.loader.exec_module(module)
-        found.append(Version(rev, _old_module(rev, "runout", folder), module))
+        found.append(Version(rev, _RowsDriver(_old_module(rev, "runout", folder)), module))
     return found
+
+
+class _RowsDriver:
+    """An older kernels module seen through today's batch driver signature
+    (`runout_batch(c, lo, hi, *outputs, tol, eps)`; before it, a prange
+    driver and a serial twin over the whole table): rows lo..hi-1 go to its
+    serial driver, the output slices being views."""
+
+    def __init__(self, module):
+        self.module = module
+
+    def __getattr__(self, name):
+        return getattr(self.module, name)
+
+    def runout_batch(self, c, lo, hi, *args):
+        if not hasattr(self.module, "runout_batch_serial"):
+            return self.module.runout_batch(c, lo, hi, *args)
+        *outputs, tol, eps = args
+        return self.module.runout_batch_serial(c[lo:hi], *(o[lo:hi] for o in outputs), tol, eps)
+
+    def whole(self, cols) -> dict | None:
+        """The whole table through the older module's own parallel driver (its
+        serial twin holds the GIL, so today's threads would not share it out);
+        None when the module already has today's driver."""
+        from impactsym.runout.batch import input_table
+
+        if not hasattr(self.module, "runout_batch_serial"):
+            return None
+        table = input_table(cols)
+        n = table.shape[0]
+        out = {k: np.empty(n) for k in ("x_rest", "y_rest", "psi_rest", "t", "distance")}
+        out["status"], out["steps"] = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+        self.module.runout_batch(table, *out.values(), self.module.TOL, self.module.EPS)
+        return out
 
 
 def _errors(rows, xs, ys, truth) -> np.ndarray:
@@ -175,14 +209,19 @@ def _throughput(n: int, versions) -> dict:
     rng = np.random.default_rng(11)
     table = rows_table([realistic_row(rng) for _ in range(n)])
     best = {v.label: math.inf for v in versions}
+
+    def call(v):
+        whole = v.jit.whole if isinstance(v.jit, _RowsDriver) else lambda _: None
+        return whole(table) or runout_batch(table)
+
     for v in versions:
         with v.active():
-            runout_batch(table)
+            call(v)
     for _ in range(REPEATS):
         for v in versions:
             with v.active():
                 start = time.perf_counter()
-                out = runout_batch(table)
+                out = call(v)
                 best[v.label] = min(best[v.label], time.perf_counter() - start)
             assert (out["status"] == 0).all()
     return {label: n / seconds for label, seconds in best.items()}

@@ -25,7 +25,7 @@ tolerances, from those three diverse candidates left after the first start
 that converged, deflated away from the state found; a run is abandoned as
 soon as an iterate comes within the distinctness thresholds (0.05 m/s, 0.02
 rad/s) of it (it is heading for that one). The scan's run-outs and the
-uniqueness starts run on threads (`_pool`; the row function releases the
+uniqueness starts run on threads (threads.py; the row function releases the
 GIL), so the starts do not deflate each other's states: two that find the
 same new state name it once. A run that converges to a state not yet found is
 polished by Newton to the full tolerances and named only if the polished state
@@ -48,13 +48,11 @@ from __future__ import annotations
 
 import functools
 import math
-import os
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from . import via
+from . import threads, via
 from .batch import columns, run_row
 from .scene import RunoutVehicle, row_values
 
@@ -309,7 +307,7 @@ def _scan(vehicle: RunoutVehicle, estimate, tol) -> list:
             miss = np.concatenate([miss, _mark_rows(vehicle, p, scale)[0]])
         return math.inf if miss is None else float(miss @ miss)
 
-    res = list(_pool().map(miss2, starts))
+    res = list(threads.pool().map(miss2, starts))
     return [starts[i] for i in np.argsort(res, kind="stable") if math.isfinite(res[i])]
 
 
@@ -397,7 +395,7 @@ def _search(vehicle: RunoutVehicle, tol, check_unique: bool) -> Fit:
             found.append(f)
             if check_unique:
                 unique = functools.partial(_unique, vehicle, tol=tol, known=list(found))
-                for g in _pool().map(unique, diverse[i:]):
+                for g in threads.pool().map(unique, diverse[i:]):
                     if g is not None and all(_distinct(g, h) for h in found):
                         found.append(g)
             break
@@ -426,16 +424,6 @@ def _unique(vehicle: RunoutVehicle, start, *, tol, known: list) -> Fit | None:
         return None
     polished.iterations += f.iterations
     return polished
-
-
-@functools.cache
-def _pool() -> ThreadPoolExecutor:
-    """The threads of the scan and the uniqueness starts (one per CPU, at most
-    four): they run independent run-outs, and the row function releases the
-    GIL (nogil), so they share out the fit's run-outs."""
-    return ThreadPoolExecutor(
-        max_workers=max(1, min(4, os.cpu_count() or 1)), thread_name_prefix="impactsym-fit"
-    )
 
 
 def _rows(vehicle: RunoutVehicle) -> int:
