@@ -20,11 +20,14 @@ from . import _door, threads
 
 DEFAULTS = {"alpha_max": math.radians(10.0), "f_r": 0.01, "g": 9.80665}
 WHEEL_DEFAULT = 0.0
-# Rows per task on the threads: 32 ran as many run-outs per second on two
-# threads as numba's prange loop did (9,170-9,240 against 9,100-9,290 a second
-# on 2,000 random rows; 8 and 128 about 1 % fewer), and a run-out's cost varies
-# by ten times, so small tasks share the load.
+# Rows per task on the threads: at least CHUNK, and at most TASKS tasks per
+# thread. 32 rows ran as many run-outs per second on two threads as numba's
+# prange loop did (9,170-9,240 against 9,100-9,290 a second on 2,000 random
+# rows; 8 and 128 about 1 % fewer; a run-out's cost varies by ten times, so
+# small tasks share the load); on 200,000 cheap rows (the locked Monte Carlo
+# of docs/runout.md) 6,250 tasks of 32 cost 10 % in submitting them.
 CHUNK = 32
+TASKS = 32
 
 
 def columns() -> tuple[str, ...]:
@@ -69,9 +72,9 @@ def runout_batch(cols, tol: float | None = None, parallel: bool | None = None) -
     """Run every row to rest; returns a dict of output arrays (see the module doc).
 
     `tol` is the integrator's local error tolerance per step (SI, absolute;
-    default generated TOL, measured in docs/runout.md). Rows run in chunks of
-    CHUNK on the room's threads (threads.py) when `parallel` (default: more
-    than one chunk), else in the calling thread."""
+    default generated TOL, measured in docs/runout.md). Rows run in chunks
+    (CHUNK, TASKS) on the room's threads (threads.py) when `parallel`
+    (default: more than CHUNK rows), else in the calling thread."""
     table = input_table(cols)
     n = table.shape[0]
     plain, jit = _door.plain(), _door.jit()
@@ -80,10 +83,12 @@ def runout_batch(cols, tol: float | None = None, parallel: bool | None = None) -
     status = np.empty(n, dtype=np.int64)
     steps = np.empty(n, dtype=np.int64)
     arrays = (out["x_rest"], out["y_rest"], out["psi_rest"], out["t"], out["distance"], status, steps)
-    if (parallel if parallel is not None else n > CHUNK) and threads.workers() > 1:
+    workers = threads.workers()
+    if (parallel if parallel is not None else n > CHUNK) and workers > 1:
+        size = max(CHUNK, -(-n // (TASKS * workers)))
         chunks = [
-            threads.pool().submit(jit.runout_batch, table, lo, min(lo + CHUNK, n), *arrays, tol, plain.EPS)
-            for lo in range(0, n, CHUNK)
+            threads.pool().submit(jit.runout_batch, table, lo, min(lo + size, n), *arrays, tol, plain.EPS)
+            for lo in range(0, n, size)
         ]
         for chunk in chunks:
             chunk.result()
