@@ -19,7 +19,8 @@ A row whose trial did not cut its squared miss fourfold gets a fresh B from
 forward differences of three run-outs. A row is converged within `draw_tolerances`:
 1 % of the draws' rest-pose spread, between fit.py's tolerances (0.1 mm,
 1e-5 rad) and 1 mm, 1e-4 rad. Rows still open after MAX_ITERATIONS go to
-fit.py's exact Newton one by one; a row that does not converge there is
+fit.py's exact Newton, a row per task on the room's threads; a row that does
+not converge there is
 reported as not fitted.
 
 Measured (`python -m benchmarks uncertainty --parts runout`, docs/runout.md):
@@ -32,10 +33,12 @@ and 1-2 % of its rows go to the exact Newton.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 
 import numpy as np
 
+from . import threads
 from .batch import columns, runout_batch
 from .fit import HEADING_TOL, POSITION_TOL, newton
 from .scene import RunoutVehicle
@@ -164,14 +167,19 @@ def fit_draws(
             B[slow] = _differences(table[slow], p[slow], r[slow], target[slow], weight[slow], tol)
             runouts += 3 * slow.size
     exact = np.flatnonzero(open_)
-    for i in exact:
-        fit = newton(_variant(vehicle, table[i], target[i]), tuple(p[i]), tol)
+    refit = functools.partial(_exact, vehicle, table, target, p, tol)
+    for i, fit in zip(exact, threads.pool().map(refit, exact)):
         if fit.converged:
             p[i] = (*fit.velocity, fit.yaw_rate)
             open_[i] = False
     out = np.where(failed, RUN_FAILED, np.where(open_, NOT_CONVERGED, 0))
     p[out != 0] = math.nan
     return DrawFit(p, out, runouts, int(exact.size))
+
+
+def _exact(vehicle: RunoutVehicle, table, target, p, tol, i: int):
+    """Row i fitted by fit.py's exact Newton from its last state (on the room's threads)."""
+    return newton(_variant(vehicle, table[i], target[i]), tuple(p[i]), tol)
 
 
 def _differences(table, p, r, target, weight, tol) -> np.ndarray:
