@@ -303,6 +303,79 @@ def heading_sensitivity_function() -> str:
     )
 
 
+def hermite_weights():
+    """The cubic through (0, p0) and (1, p1) with slopes h m0 and h m1 (a step of
+    length h in time, s = (t - t0)/h): its weights on (p0, m0, p1, m1) as
+    functions of s and h, solved from the four end conditions. Returns
+    ((s, h), weights of the value, of d/dt, of d2/dt2)."""
+    s_, h_ = sp.symbols("s h", positive=True)
+    c = sp.symbols("c0:4")
+    p0, m0, p1, m1 = sp.symbols("p0 m0 p1 m1")
+    cubic = sum(ci * s_**i for i, ci in enumerate(c))
+    ends = [cubic.subs(s_, 0) - p0, cubic.diff(s_).subs(s_, 0) - h_ * m0]
+    ends += [cubic.subs(s_, 1) - p1, cubic.diff(s_).subs(s_, 1) - h_ * m1]
+    value = sp.expand(cubic.subs(sp.solve(ends, c)))
+    rows = [value, value.diff(s_) / h_, value.diff(s_, 2) / h_**2]
+    return (s_, h_), [[sp.factor(sp.expand(r).coeff(x)) for x in (p0, m0, p1, m1)] for r in rows]
+
+
+def foot_time_sensitivity():
+    """dt*/dp of the moment t* the path X(t, p) passes nearest a point q:
+    t* solves g = (q - X)·V = 0 (V = dX/dt), so dt*/dp = -g_p/g_t =
+    ((q - X)·V_p - V·X_p) / (|V|^2 - (q - X)·A), A = dV/dt, V_p = dX_p/dt
+    (proved against the implicit differentiation of g in `_foot_claims`).
+    Returns (inputs, expression)."""
+    qx, qy, X1, X2, V1, V2, A1, A2 = sp.symbols("qx qy X1 X2 V1 V2 A1 A2", real=True)
+    P1, P2, W1, W2 = sp.symbols("Xp1 Xp2 Vp1 Vp2", real=True)
+    num = (qx - X1) * W1 + (qy - X2) * W2 - (V1 * P1 + V2 * P2)
+    den = V1**2 + V2**2 - ((qx - X1) * A1 + (qy - X2) * A2)
+    return (qx, qy, X1, X2, V1, V2, A1, A2, P1, P2, W1, W2), num / den
+
+
+def _foot_claims():
+    """The Hermite weights meet their end conditions; `foot_time_sensitivity`
+    is -g_p/g_t of g(t, p) = (q - X(t, p))·dX/dt for a general path X."""
+    (s_, h_), (value, slope, _) = hermite_weights()
+    p = sp.symbols("p0 m0 p1 m1")
+    v = sum(w * x for w, x in zip(value, p))
+    d = sum(w * x for w, x in zip(slope, p))
+    ends = [v.subs(s_, 0) - p[0], d.subs(s_, 0) - p[1], v.subs(s_, 1) - p[2], d.subs(s_, 1) - p[3]]
+    hermite = all(sp.simplify(e) == 0 for e in ends) and sp.simplify(d - v.diff(s_) / h_) == 0
+    t, pp = sp.symbols("t p", real=True)
+    X = [sp.Function("X1")(t, pp), sp.Function("X2")(t, pp)]
+    args, expr = foot_time_sensitivity()
+    qx, qy = args[:2]
+    g = (qx - X[0]) * X[0].diff(t) + (qy - X[1]) * X[1].diff(t)
+    implicit = -g.diff(pp) / g.diff(t)
+    names = dict(zip(args[2:], [X[0], X[1], X[0].diff(t), X[1].diff(t), X[0].diff(t, 2), X[1].diff(t, 2)]))
+    names |= dict(zip(args[8:], [X[0].diff(pp), X[1].diff(pp), X[0].diff(t, pp), X[1].diff(t, pp)]))
+    foot = sp.simplify(expr.xreplace(names) - implicit) == 0
+    return [
+        ("run-out path: the cubic Hermite weights meet p(0), p'(0), p(1), p'(1)", hermite),
+        ("run-out path: dt*/dp of the nearest passage = -g_p/g_t, g = (q - X).dX/dt", foot),
+    ]
+
+
+def via_functions() -> str:
+    """`hermite_weights` and `foot_time_sensitivity` as plain Python for
+    generated/runout.py (impactsym/runout/via.py calls them; their arguments
+    may be NumPy arrays)."""
+    (s_, h_), rows = hermite_weights()
+    weights = ",\n        ".join("(" + ", ".join(emit.code(w) for w in row) + ")" for row in rows)
+    args, expr = foot_time_sensitivity()
+    return (
+        "def hermite_weights(s, h):\n"
+        '    """Weights on (p0, m0, p1, m1) of the cubic Hermite interpolant at s in [0, 1]\n'
+        '    of a step h [s]: (value, d/dt, d2/dt2) (derive/runout.py `hermite_weights`)."""\n'
+        f"    return (\n        {weights},\n    )\n\n\n"
+        f"def foot_time_sensitivity({', '.join(str(a) for a in args)}):\n"
+        '    """dt*/dp of the moment the path passes nearest (qx, qy): X, V, A the position,\n'
+        "    velocity and acceleration there, Xp, Vp their derivatives with respect to p\n"
+        '    (derive/runout.py `foot_time_sensitivity`)."""\n'
+        f"    return {emit.code(expr)}\n"
+    )
+
+
 def _symbolic_claims():
     """Chassis identities with arbitrary wheel-frame forces (F_l, F_s): the
     scene force is the wheel force rotated by psi + delta, with norm
@@ -493,7 +566,7 @@ def _stiff_step_claims():
 
 def proofs():
     """(claim, passed) for the run-out model."""
-    return _symbolic_claims() + _rotation_claims() + _numeric_claims() + _stiff_step_claims()
+    return _symbolic_claims() + _rotation_claims() + _foot_claims() + _numeric_claims() + _stiff_step_claims()
 
 
 # --- emission ------------------------------------------------------------------
@@ -605,6 +678,8 @@ def render_plain(digest: str) -> str:
         emit.header("runout.py", digest).rstrip("\n"),
         f"# 0 kernels; rest_heading_sensitivity: {sum(sp.count_ops(e) for e in heading_sensitivity()[1])} "
         "arithmetic operations after common-subexpression elimination;",
+        f"# foot_time_sensitivity: {sp.count_ops(foot_time_sensitivity()[1])} operations; "
+        f"hermite_weights: {sum(sp.count_ops(w) for row in hermite_weights()[1] for w in row)} operations;",
         "# constants otherwise;",
         "# the wheel forces, batch driver and integrator are in generated/runout_jit.py.",
         "",
@@ -624,6 +699,9 @@ def render_plain(digest: str) -> str:
         "",
         "",
         heading_sensitivity_function().rstrip("\n"),
+        "",
+        "",
+        via_functions().rstrip("\n"),
     ]
     return "\n".join(parts) + "\n"
 

@@ -478,7 +478,8 @@ def test_an_interrupted_sweep_leaves_no_spill_file_and_no_traceback(tmp_path, si
         out, err = process.communicate(timeout=60)
     finally:
         process.kill()
-    assert process.returncode == code
+    # stderr in the message: where a lost signal landed is printed there ("Exception ignored ...").
+    assert process.returncode == code, err.decode()[-3000:]
     assert err.decode() == f"impactsym: {said}\n"
     assert list(temp.iterdir()) == []
 

@@ -22,7 +22,9 @@ p = (vx, vy, w) follow the foot of the perpendicular: differentiating
     dt*/dp = ((q - X)·V_p - V·X_p) / (|V|^2 - (q - X)·A),
 
 A the acceleration, so dX(t*)/dp = X_p + V dt*/dp and dpsi(t*)/dp =
-psi_p + w dt*/dp (dt*/dp = 0 when t* is an end of the path).
+psi_p + w dt*/dp (dt*/dp = 0 when t* is an end of the path). The Hermite weights
+and dt*/dp are derived and proved in derive/runout.py (`hermite_weights`,
+`foot_time_sensitivity`) and emitted into generated/runout.py.
 
 Path rows (`run_row` with ``path_columns=PATH_COLUMNS``): t, then the state
 (x, y, psi, vx, vy, w, distance) and its sensitivities S[i, j] = d y_i/d p_j at
@@ -32,6 +34,8 @@ column 8 + 4 i + j (generated/runout_jit.py).
 from __future__ import annotations
 
 import numpy as np
+
+from . import _door
 
 PATH_COLUMNS = 32  # t, the 7 states, the 6 x 4 sensitivities
 PATH_ROWS = 50_000  # accepted steps held (the buffer is only touched as far as it is filled)
@@ -45,12 +49,9 @@ def _sens(i: int) -> slice:
 
 def _hermite(s: float, h: float):
     """Weights of the cubic Hermite interpolant at s in [0, 1] of a step h [s]:
-    (value, d/dt, d2/dt2) weights for (p0, m0, p1, m1)."""
-    s2, s3 = s * s, s * s * s
-    value = np.array([2 * s3 - 3 * s2 + 1, h * (s3 - 2 * s2 + s), -2 * s3 + 3 * s2, h * (s3 - s2)])
-    slope = np.array([6 * s2 - 6 * s, h * (3 * s2 - 4 * s + 1), -6 * s2 + 6 * s, h * (3 * s2 - 2 * s)]) / h
-    curve = np.array([12 * s - 6, h * (6 * s - 4), -12 * s + 6, h * (6 * s - 2)]) / (h * h)
-    return value, slope, curve
+    (value, d/dt, d2/dt2) weights for (p0, m0, p1, m1) (generated/runout.py,
+    derived and proved in derive/runout.py)."""
+    return tuple(np.array(w) for w in _door.plain().hermite_weights(s, h))
 
 
 def _at(path: np.ndarray, k: int, s: float):
@@ -126,8 +127,12 @@ def residuals(via, path: np.ndarray, scale: float, jacobian: bool):
             continue
         Xp, Vp, psip = _sensitivities(path, k, value, slope)
         at_end = (k == 0 and s == 0.0) or (k == last - 1 and s == 1.0) or value is None
-        denom = float(V @ V) - float((q - X) @ A)
-        dt = np.zeros(3) if at_end or denom <= 0.0 else ((q - X) @ Vp - V @ Xp) / denom
+        denom = float(V @ V) - float((q - X) @ A)  # > 0 at a nearest passage
+        dt = (
+            np.zeros(3)
+            if at_end or denom <= 0.0
+            else _door.plain().foot_time_sensitivity(*q, *X, *V, *A, *Xp, *Vp)
+        )
         J = Xp + np.outer(V, dt)
         rows += [J[0], J[1]]
         if psi is not None:
