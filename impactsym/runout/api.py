@@ -50,8 +50,11 @@ def _vehicle(sc: RunoutScene, v: RunoutVehicle, index: int, path: bool, tol, war
         vx, vy, w = fit.velocity[0], fit.velocity[1], fit.yaw_rate
     else:
         (vx, vy), w = v.velocity, v.yaw_rate
+    # One run-out gives the drawn path and, with intermediate poses, their misses
+    # (the path then holds each step's whole state: t, x, y, psi, vx, vy, w, distance).
+    points = max(PATH_POINTS if path else 0, via.PATH_ROWS if v.via else 0)
     y, t, status, _, pts = run_row(
-        row_values(v, columns(), vx, vy, w), tol=tol, path_points=PATH_POINTS if path else 0
+        row_values(v, columns(), vx, vy, w), tol=tol, path_points=points, path_columns=8 if v.via else 4
     )
     if status != 0:
         raise SceneError(f"the run-out failed: {status_text(status)}", f"vehicles[{index}]")
@@ -76,7 +79,10 @@ def _vehicle(sc: RunoutScene, v: RunoutVehicle, index: int, path: bool, tol, war
         residual["position"] = math.hypot(y[0] - v.rest[0], y[1] - v.rest[1]) / length
         residual["heading"] = abs(math.degrees(y[2] - v.rest[2]))
     if v.via:
-        residual["intermediate"] = _via_misses(v, row_values(v, columns(), vx, vy, w), tol, length)
+        residual["intermediate"] = [
+            {"position": d / length} | ({} if a is None else {"heading": math.degrees(a)})
+            for d, a in via.misses(v.via, via.residuals(v.via, pts, 1.0, jacobian=False)[0], 1.0)
+        ]
     if fit is not None:
         if v.marks:
             names = {"fl": "front_left", "fr": "front_right", "rl": "rear_left", "rr": "rear_right"}
@@ -87,21 +93,6 @@ def _vehicle(sc: RunoutScene, v: RunoutVehicle, index: int, path: bool, tol, war
     if path:
         entry["path"] = [[p[0], p[1] / length, p[2] / length, math.degrees(p[3])] for p in pts]
     return entry
-
-
-def _via_misses(v: RunoutVehicle, values, tol, length: float) -> list:
-    """Per intermediate pose, how far the run-out passes from it: ``{"position":
-    distance (scene length), "heading": deg}`` (heading only where given)."""
-    _, _, _, _, path = run_row(values, tol=tol, path_points=via.PATH_ROWS, path_columns=8)
-    r, _ = via.residuals(v.via, path, 1.0, jacobian=False)
-    out = []
-    for _, _, psi in v.via:
-        entry = {"position": math.hypot(r[0], r[1]) / length}
-        if psi is not None:
-            entry["heading"] = abs(math.degrees(r[2]))
-        out.append(entry)
-        r = r[2 if psi is None else 3 :]
-    return out
 
 
 def _unit(sc: RunoutScene) -> str:

@@ -166,16 +166,6 @@ def _evaluate(vehicle, cols, p, tol):
     return r, J
 
 
-def _via_misses(vehicle: RunoutVehicle, r, scale: float) -> list:
-    """(position miss [m], heading miss [rad] or None) per intermediate pose,
-    from the pose rows at the end of the residual vector."""
-    rows, out = r[3 + len(vehicle.marks) :], []
-    for _, _, psi in vehicle.via:
-        out.append((math.hypot(rows[0], rows[1]), None if psi is None else abs(rows[2]) / scale))
-        rows = rows[2 if psi is None else 3 :]
-    return out
-
-
 def _mark_rows(vehicle: RunoutVehicle, p, scale: float):
     """Residuals (wrapped angle differences times `scale`) and Jacobian rows of
     the tyre-mark directions: a mark leaves along the wheel's contact-point
@@ -278,7 +268,7 @@ def _newton(vehicle: RunoutVehicle, start, tol, budget: int, coarse: float = 1.0
         bool(_done(r, scale, coarse) or stalled),
         tuple(start),
         marks=[float(x) / scale for x in r[3 : 3 + len(vehicle.marks)]],
-        via=_via_misses(vehicle, r, scale),
+        via=via.misses(vehicle.via, r[3 + len(vehicle.marks) :], scale),
         cost=float(r @ r),
     )
 
@@ -374,6 +364,13 @@ def _fit_evidence(vehicle: RunoutVehicle, tol, check_unique: bool) -> Fit:
             return other
         if other.converged and all(_distinct(other, g) for g in found):
             found.append(other)
+    return _least_cost(vehicle, found, check_unique)
+
+
+def _least_cost(vehicle: RunoutVehicle, found: list, check_unique: bool) -> Fit:
+    """Of the states `found` for a fit with further evidence, the one with the
+    least squared residual; the others within EVIDENCE_COST_SHARE of it (or
+    the tolerance per row) as its alternatives."""
     best = min(found, key=lambda f: f.cost)
     bound = EVIDENCE_COST_SHARE * best.cost + _rows(vehicle) * POSITION_TOL**2
     best.alternatives = [f for f in found if f is not best and f.cost <= bound] if check_unique else []
@@ -402,10 +399,7 @@ def _search(vehicle: RunoutVehicle, tol, check_unique: bool) -> Fit:
     if not found:
         return first
     if vehicle.marks or vehicle.via:  # least squares: the state that fits the evidence best
-        best = min(found, key=lambda f: f.cost)
-        bound = EVIDENCE_COST_SHARE * best.cost + _rows(vehicle) * POSITION_TOL**2
-        best.alternatives = [f for f in found if f is not best and f.cost <= bound]
-        return best
+        return _least_cost(vehicle, found, check_unique)
     est = np.array(estimate)
     best = min(found, key=lambda f: _distance(f, est))
     best.alternatives = [f for f in found if f is not best]

@@ -140,6 +140,16 @@ def residuals(via, path: np.ndarray, scale: float, jacobian: bool):
     return np.array(res), (np.array(rows).reshape(-1, 3) if jacobian else None)
 
 
+def misses(via, rows, scale: float) -> list:
+    """(position miss [m], heading miss [rad] or None) per intermediate pose, from
+    its residual rows (`residuals`, heading rows times `scale`)."""
+    out = []
+    for _, _, psi in via:
+        out.append((float(np.hypot(rows[0], rows[1])), None if psi is None else abs(float(rows[2])) / scale))
+        rows = rows[2 if psi is None else 3 :]
+    return out
+
+
 def _sensitivities(path: np.ndarray, k: int, value, slope):
     """(X_p (2, 3), V_p (2, 3), psi_p (3,)) at the interpolated point."""
     if value is None:
