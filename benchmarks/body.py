@@ -48,7 +48,7 @@ def _case_runner(case, rows: int):
     inputs = [_kernels.as_input(x) for x in case.inputs()]
     columns = runner._driver_columns(ks, inputs)
     columns = [c if c is None or isinstance(c, np.ndarray) else np.full(rows, c) for c in columns]
-    outs = [np.empty(rows) for _ in ks.outputs] + [np.empty(rows, np.int32), np.empty(rows, np.int32)]
+    outs = [*runner.allocate(ks, rows).values(), np.empty(rows, np.int32), np.empty(rows, np.int32)]
     driver = ks.driver
     return lambda: driver(*columns, *outs)
 

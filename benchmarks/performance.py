@@ -792,7 +792,7 @@ def _threshold_calls(columns: dict, n: int) -> dict:
     ks = _kernels.kernel_for("rigid", False)
     inputs = [np.ascontiguousarray(columns[k][:n]) for k in ks.inputs]
     driven = runner._driver_columns(ks, inputs)
-    outs = [np.empty(n) for _ in ks.outputs] + [np.empty(n, dtype=np.int32) for _ in range(2)]
+    outs = [*runner.allocate(ks, n).values(), np.empty(n, dtype=np.int32), np.empty(n, dtype=np.int32)]
     threads = numba.get_num_threads()
 
     def one_thread(call):

@@ -364,6 +364,8 @@ def kernel(law: str) -> Kernel:
         outputs=OUTPUTS,
         flags=flags,
         finite=tuple(s for s in OUTPUTS if s not in (mu_used, mu_c)),
+        constants=ks.POINT_IMPULSE,
+        integers=(slip_class,),
         family="coulomb",
         variant=(("restitution_law", law),),
     )

@@ -399,6 +399,7 @@ def manifest_entry(kernel: Kernel, operations: int) -> dict:
         "arguments": tuple(str(s) for s in kernel.inputs),
         "outputs": kernel.output_names(),
         "constants": dict(kernel.constants),
+        "integers": tuple(str(s) for s in kernel.integers),
         "tier": tier(kernel),
         "angle": None if kernel.angle is None else str(kernel.angle),
         "equations": tuple(b.equation for b in kernel.blocks if b.equation),
@@ -520,7 +521,11 @@ def body_function(prog: Program, style: Style = DEFAULT) -> str:
     lines.append(f'{ind}"""`{knl.name}` (generated/ per-scene function) without branches."""')
     lines += _lines(prog, ind, style, straight=True)
     lines.append(f"{ind}ok = status == 0")
-    values = [f"{s} if ok else math.nan" for s in knl.outputs] + ["status", "flags if ok else 0"]
+    # A failed row: NaN, or -1 for a class code (its driver column is int64);
+    # the constants are written too, so the runtime fills no column afterwards.
+    values = [f"{s} if ok else {-1.0 if s in knl.integers else 'math.nan'}" for s in knl.outputs]
+    values += [f"{value!r} if ok else math.nan" for _, value in knl.constants]
+    values += ["status", "flags if ok else 0"]
     lines += _wrap(f"{ind}return (", values, ")", ind * 2)
     return "\n".join(lines) + "\n"
 
@@ -548,7 +553,8 @@ def driver_function(kernel: Kernel, style: Style = DEFAULT) -> str:
     the angle column (`_sincos` per row), or `normal`, one (nx, ny) for every
     row as a length-2 array read once before the loop (no filled columns to
     write and read again), or (nx, ny) columns (angles beyond SINCOS_LIMIT,
-    whose normal the runtime forms with NumPy); the other two are None.
+    which the angle loop counts and returns, whose normal the runtime then
+    forms with NumPy); the other two are None.
 
     Why three separate `if ... is not None` and not if/elif: numba prunes a
     branch on an argument typed None before it types the function, so each
@@ -556,7 +562,7 @@ def driver_function(kernel: Kernel, style: Style = DEFAULT) -> str:
     copy of the body, not three (an `elif` after a test on an array cannot be
     pruned: numba knows only that a None is None)."""
     args = [str(s) for s in kernel.inputs]
-    outs = [f"out_{s}" for s in kernel.output_names()] + ["out_status", "out_flags"]
+    outs = [f"out_{s}" for s in kernel.driver_output_names()] + ["out_status", "out_flags"]
     ind = "        "
     lines = [f"@{style.jit(parallel=True)}"]
     lines += _wrap(
@@ -569,9 +575,15 @@ def driver_function(kernel: Kernel, style: Style = DEFAULT) -> str:
     angle = f"c_{kernel.angle}"
     lines += [
         "    n = out_status.shape[0]",
+        "    beyond = 0",
         f"    if {angle} is not None:",
         "        for i in prange(n):",
-        f"            ny, nx = _sincos({angle}[i])",
+        f"            g = {angle}[i]",
+        "            # finite angles beyond SINCOS_LIMIT, counted in the same pass (no pass",
+        "            # over the column before the call): the runtime solves such a batch",
+        "            # again with NumPy's normals",
+        f"            beyond += 1 if (abs(g) > {SINCOS_LIMIT!r}) & (g - g == 0.0) else 0",
+        "            ny, nx = _sincos(g)",
         *_row(kernel, args, outs, ind + "    ", True),
         "    if c_normal is not None:",
         "        nx, ny = c_normal[0], c_normal[1]",
@@ -581,6 +593,7 @@ def driver_function(kernel: Kernel, style: Style = DEFAULT) -> str:
         "        for i in prange(n):",
         "            nx, ny = c_nx[i], c_ny[i]",
         *_row(kernel, args, outs, ind + "    ", True),
+        "    return beyond",
     ]
     return "\n".join(lines) + "\n"
 
@@ -673,8 +686,10 @@ def render_registry(modules, digest: str, tiers: dict) -> str:
         "per-scene function <name>, generated/<module>_jit.py the driver <name>_batch),",
         "driver (its input columns in order, None if the kernel has no driver), doc,",
         "columns (batch inputs), arguments (per-scene function arguments), outputs",
-        "(computed), constants (outputs fixed to a number), tier, angle, equations,",
-        'operations. FAMILY_OUTPUTS[family]: every output a family returns."""',
+        "(computed), constants (outputs fixed to a number; a driver writes the outputs, then",
+        "the constants), integers (outputs coding a class: int64 in a driver, -1 on a failed",
+        "row), tier, angle, equations, operations. FAMILY_OUTPUTS[family]: every output a",
+        'family returns."""',
         "",
     ]
     for name, value in tables:

@@ -261,6 +261,8 @@ def _kernel(rigid: bool) -> Kernel:
         blocks=blocks + (tolerances,),
         outputs=outputs,
         flags=flags,
+        # particles neither turn nor take a moment: the rigid outputs they lack
+        constants=() if rigid else (("w1", 0.0), ("w2", 0.0), ("M", 0.0), ("TLm", 0.0)),
         family="inverse",
         variant=(("model", "rigid" if rigid else "particle"),),
     )

@@ -55,6 +55,10 @@ class Kernel:
     `constants` (outputs that are a fixed number, published by name rather
     than computed), `finite` (see `finite_checked`) and `angle` (the angle
     input that the normal components (nx, ny) among `inputs` stand for).
+    A kernel whose model lacks an output (particles: no yaw; a point impulse:
+    no moment) names it among `constants` too, so that its drivers write
+    every output of the model's tier. `integers` are outputs that code a
+    class (0, 1, 2, ...): the drivers write them as int64, -1 on a failed row.
     `family` and `variant` place the kernel in the registry
     (generated/registry.py): the family it belongs to (default: its name) and
     what distinguishes it there, as (key, value) pairs: ("critical", True),
@@ -71,6 +75,7 @@ class Kernel:
     constants: tuple[tuple[str, float], ...] = ()
     finite: tuple[sp.Symbol, ...] | None = None
     angle: sp.Symbol | None = None
+    integers: tuple[sp.Symbol, ...] = ()
     family: str = ""
     variant: tuple[tuple[str, object], ...] = ()
 
@@ -87,6 +92,11 @@ class Kernel:
     def output_names(self) -> tuple[str, ...]:
         """Public output names (batch columns) of the computed outputs."""
         return tuple(self.public_name(s) for s in self.outputs)
+
+    def driver_output_names(self) -> tuple[str, ...]:
+        """What a batch driver writes, in order: the computed outputs, then the
+        constants (then status and flags)."""
+        return self.output_names() + tuple(name for name, _ in self.constants)
 
     def finite_checked(self) -> tuple[sp.Symbol, ...]:
         """The quantities whose overflow makes a row fail (status OVERFLOW):

@@ -96,6 +96,8 @@ c1, c2 = real("c1 c2")
 INPUTS_FULL = (m1, m2, I1, I2, v1x, v1y, w1, v2x, v2y, w2, r1x, r1y, r2x, r2y, gamma, e)
 INPUTS_SLIDING = INPUTS_FULL + (mu_f,)
 OUTPUTS = (V1x, V1y, W1, V2x, V2y, W2, Pn, Pt, mu_used, mu_c, dV1, dV2, TL, TLn, TLt, slide)
+# A point impulse: no moment, no work of one (the laws' kernels publish them as constants).
+POINT_IMPULSE = (("M", 0.0), ("TLm", 0.0))
 
 
 def compliance_coefficients():
@@ -289,6 +291,8 @@ def kernel(sliding: bool) -> Kernel:
         # mu and mu_c are NaN where undefined (Pn = 0; a sticking impulse with
         # Pn = 0): reported as such, not a failed row.
         finite=tuple(s for s in OUTPUTS if s not in (mu_used, mu_c)),
+        constants=POINT_IMPULSE,
+        integers=(slide,),
         family="kudlich_slibar",
         variant=(("contact", "sliding" if sliding else "full"),),
     )

@@ -190,10 +190,14 @@ def kernel(sticking: bool) -> Kernel:
         blocks=_kernel_blocks(sticking) + (tolerances,),
         outputs=OUTPUTS,
         flags=flags,
+        constants=NO_ROTATION,
         family="particle",
         variant=(("critical", True),) if sticking else (),
     )
 
+
+# Particles neither turn nor take a moment: the rigid model's outputs they lack.
+NO_ROTATION = (("W1", 0.0), ("W2", 0.0), ("M", 0.0), ("TLm", 0.0))
 
 KERNELS = (kernel(sticking=False), kernel(sticking=True))
 

@@ -156,6 +156,7 @@ def prune(kernel: Kernel, name: str, outputs: tuple[str, ...], doc: str = "", ti
         blocks=tuple(reversed(blocks)),
         outputs=keep,
         constants=tuple((n, v) for n, v in kernel.constants if n in outputs),
+        integers=tuple(s for s in kernel.integers if s in keep),
         finite=tuple(s for s in kernel.finite_checked() if s in computed),
         family=kernel.family_name(),
         variant=kernel.variant + ((("tier", tier),) if tier else ()),

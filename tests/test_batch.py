@@ -168,16 +168,35 @@ def test_a_read_only_install_caches_compiled_drivers_in_the_user_directory(tmp_p
 @pytest.mark.parametrize(
     "angles, beyond",
     [
-        ([0.1, -3.0, 2.0], False),
-        ([10.0, -10.0], False),  # at the limit: the angle driver still serves it
-        ([np.nan, 11.0], True),  # NaN does not hide an angle beyond the limit
-        ([-11.0, np.nan, 0.0], True),
-        ([np.inf, -np.inf, 1.0], False),  # ±inf is a bad row (status 1), not beyond
-        ([np.inf, np.nan, -12.0], True),
-        ([np.nan, np.nan], False),
+        ([0.01, -0.3, 0.2], 0),
+        ([1.0, -1.0], 0),  # at the limit: the angle loop still serves it
+        ([np.nan, 1.1], 1),  # NaN does not hide an angle beyond the limit
+        ([-1.1, np.nan, 0.0], 1),
+        ([np.inf, -np.inf, 0.1], 0),  # ±inf is a bad row (status 1), not beyond
+        ([np.inf, np.nan, -1.2, 1.3], 2),
+        ([np.nan, np.nan], 0),
     ],
 )
-def test_angles_beyond_the_sincos_limit_are_found_past_nan_and_inf(angles, beyond):
-    from impactsym._kernels.runner import _beyond
+def test_the_angle_loop_counts_the_angles_beyond_the_sincos_limit(angles, beyond):
+    """The driver's angle loop returns how many finite angles are beyond
+    SINCOS_LIMIT (angles given here in units of the limit, the limit itself
+    served), past NaN and ±inf; the runtime then solves the batch with NumPy's
+    normals, as the per-scene function does."""
+    from impactsym._kernels import kernel_for, solve_one
+    from impactsym._kernels.registry import SINCOS_LIMIT
+    from impactsym._kernels.runner import allocate
 
-    assert _beyond(np.array(angles), 10.0) is beyond
+    ks = kernel_for("rigid", False)
+    gamma = np.array(angles) * SINCOS_LIMIT
+    n = len(gamma)
+    columns = scenes.random_realistic(n, seed=3)
+    inputs = [gamma if name == "gamma" else np.ascontiguousarray(columns[name][:n]) for name in ks.inputs]
+    at = ks.inputs.index("gamma")
+    driven = inputs[:at] + [gamma, None, None, None] + inputs[at + 1 :]
+    outs = [*allocate(ks, n).values(), np.empty(n, np.int32), np.empty(n, np.int32)]
+    assert ks.driver(*driven, *outs) == beyond
+    got = impactsym.solve_batch({**{k: v[:n] for k, v in columns.items()}, "gamma": gamma})
+    for i in range(n):
+        one = solve_one("rigid", False, {k: float(v[i]) for k, v in columns.items()} | {"gamma": gamma[i]})
+        assert got["status"][i] == one["status"]
+        np.testing.assert_array_equal([got[k][i] for k in OUTPUTS], [one[k] for k in OUTPUTS])

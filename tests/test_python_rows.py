@@ -95,14 +95,23 @@ def _scene_rows(ks, inputs: list, n: int):
     results = list(map(ks.scene, *rows))
     columns = list(zip(*results))
     outs = {name: np.array(columns[k], dtype=float) for k, name in enumerate(ks.outputs)}
-    return outs, np.array(columns[-2], dtype=np.int32), np.array(columns[-1], dtype=np.int32)
+    status = np.array(columns[-2], dtype=np.int32)
+    # What a driver writes besides: a class code as int64, -1 where the row
+    # failed (NaN here); the kernel's constants, NaN where the row failed.
+    for name in ks.integers:
+        outs[name] = np.where(np.isnan(outs[name]), -1, outs[name]).astype(np.int64)
+    for name, value in ks.constants.items():
+        outs[name] = np.where(status == 0, value, np.nan)
+    return outs, status, np.array(columns[-1], dtype=np.int32)
 
 
 def _assert_same(python, drivers, label: str) -> None:
     (p_outs, p_status, p_flags), (d_outs, d_status, d_flags) = python, drivers
     np.testing.assert_array_equal(p_status, d_status, err_msg=f"{label}: status")
     np.testing.assert_array_equal(p_flags, d_flags, err_msg=f"{label}: flags")
+    assert list(d_outs) == list(p_outs), f"{label}: the driver's columns"
     for name in d_outs:
+        assert d_outs[name].dtype == p_outs[name].dtype, f"{label}: {name} dtype"
         same = (p_outs[name] == d_outs[name]) | (np.isnan(p_outs[name]) & np.isnan(d_outs[name]))
         assert same.all(), f"{label}: {name} differs in {np.count_nonzero(~same)} rows"
 

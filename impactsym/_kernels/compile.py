@@ -15,7 +15,7 @@ from .registry import batch_kernels
 
 def compile_all(progress: Callable[[str], None] | None = None) -> int:
     """Compile every driver with the signatures the runtime calls it with:
-    float64 C arrays in and out, int32 status and flags, and for a kernel in
+    float64 C arrays in and out (int64 for a class code), int32 status and flags, and for a kernel in
     normal form the two forms of the normal a batch of real angles uses (an
     angle per row, one normal for the batch; the forms not given are None).
     The third, (nx, ny) columns, serves only angles beyond SINCOS_LIMIT (about
@@ -38,7 +38,8 @@ def _signatures(ks) -> list[tuple]:
     from numba import types
 
     array, none = types.float64[::1], types.none
-    outs = (array,) * len(ks.outputs) + (types.int32[::1],) * 2
+    outs = tuple(types.int64[::1] if name in ks.integers else array for name in ks.driver_outputs)
+    outs += (types.int32[::1],) * 2
     columns = [array] * len(ks.driver_columns)
     if ks.angle is None:
         return [(*columns, *outs)]

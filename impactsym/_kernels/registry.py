@@ -73,7 +73,10 @@ class KernelSet:
     `inputs` are the batch columns, `arguments` the per-scene function's
     (nx, ny in place of the angle for a kernel in normal form), `driver_columns`
     the driver's (the angle, then nx, ny), `outputs` the computed outputs and
-    `constants` the outputs the kernel fixes to a number (e_m = 1: M = 0).
+    `constants` the outputs the kernel fixes to a number (e_m = 1: M = 0;
+    a model without that output: particles' W1), which its driver writes after
+    `outputs` (`driver_outputs`); `integers` the outputs coding a class, int64
+    columns of the driver (-1 on a failed row).
     `scene`, `unit_normal` (plain Python) and `driver` (numba) are imported on
     first access."""
 
@@ -86,8 +89,14 @@ class KernelSet:
     driver_columns: tuple[str, ...] | None
     outputs: tuple[str, ...]
     constants: dict
+    integers: tuple[str, ...]
     angle: str | None
     operations: int
+
+    @property
+    def driver_outputs(self) -> tuple[str, ...]:
+        """The columns a driver writes, in order (then status and flags)."""
+        return self.outputs + tuple(self.constants)
 
     @property
     def scene(self):
@@ -119,6 +128,7 @@ def kernel(name: str) -> KernelSet:
         driver_columns=row["driver"],
         outputs=row["outputs"],
         constants=row["constants"],
+        integers=row["integers"],
         angle=row["angle"],
         operations=row["operations"],
     )

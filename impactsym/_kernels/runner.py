@@ -6,9 +6,10 @@ normal's forms the batch does not use), so each driver compiles once per
 machine and form of the normal (numba's on-disk cache) whatever mix of scalar
 and array columns a caller gives: a scalar column becomes a filled array,
 reused chunk after chunk (`FILL_BYTES`). An angle column is passed as it is
-(the driver forms the normal per row); one angle for the batch becomes its
-normal, once, as the length-2 `normal` that the driver reads before its loop;
-per-row angles beyond SINCOS_LIMIT get NumPy's cos/sin as (nx, ny) columns. Every batch runs the driver's
+(the driver forms the normal per row and counts the finite angles beyond
+SINCOS_LIMIT in the same loop: a batch with any is solved again with NumPy's
+cos/sin as (nx, ny) columns); one angle for the batch becomes its normal,
+once, as the length-2 `normal` that the driver reads before its loop. Every batch runs the driver's
 `prange` loop, however small: on one row the launch costs a few microseconds
 more than a serial loop, measured in benchmarks/results/performance.md.
 """
@@ -20,7 +21,7 @@ import threading
 
 import numpy as np
 
-from .registry import SINCOS_LIMIT, KernelSet
+from .registry import KernelSet
 
 # Scalar columns become filled arrays of at most FILL_BYTES together (and at
 # least MIN_CHUNK rows), reused chunk after chunk. Few large chunks: on a busy
@@ -53,31 +54,41 @@ def run_batch(ks: KernelSet, inputs: list, n: int | None = None) -> tuple[dict, 
 def run(ks: KernelSet, inputs: list, n: int | None = None) -> tuple[dict, np.ndarray, np.ndarray]:
     """Run a kernel's driver over `inputs` (in `ks.inputs` order, each as
     `as_input` gives it: an array of the batch length or a float for every
-    row) and return (computed outputs by name, status, flags) in freshly
-    allocated arrays."""
+    row) and return (every output the driver writes by name: computed and
+    constant, status, flags) in freshly allocated arrays."""
     if n is None:
         n = max((x.shape[0] for x in inputs if isinstance(x, np.ndarray)), default=1)
-    outs = {name: np.empty(n) for name in ks.outputs}
+    outs = allocate(ks, n)
     status = np.empty(n, dtype=np.int32)
     flags = np.empty(n, dtype=np.int32)
-    if n:
-        _call(ks.driver, _driver_columns(ks, inputs), [*outs.values(), status, flags])
+    columns = [*outs.values(), status, flags]
+    if n and _call(ks.driver, _driver_columns(ks, inputs), columns):
+        _call(ks.driver, _driver_columns(ks, inputs, numpy_normal=True), columns)
     return outs, status, flags
 
 
-def _driver_columns(ks: KernelSet, inputs: list) -> list:
+def allocate(ks: KernelSet, n: int) -> dict:
+    """Empty output columns of `n` rows for the driver of `ks`, by name in its
+    order: float64, int64 for a class code."""
+    return {
+        name: np.empty(n, dtype=np.int64 if name in ks.integers else np.float64) for name in ks.driver_outputs
+    }
+
+
+def _driver_columns(ks: KernelSet, inputs: list, numpy_normal: bool = False) -> list:
     """The driver's columns in its order (scalars still scalars). For a kernel
     in normal form, (angle, nx, ny, normal): the angle column, or one normal
-    for every row as the length-2 `normal`, or per-row normals from NumPy
-    beyond SINCOS_LIMIT; None for the other forms (the driver compiles only
-    the loop of the form it is given: derive/emit.py `driver_function`)."""
+    for every row as the length-2 `normal`, or with `numpy_normal` per-row
+    normals from NumPy (for angles beyond SINCOS_LIMIT); None for the other
+    forms (the driver compiles only the loop of the form it is given:
+    derive/emit.py `driver_function`)."""
     if ks.angle is None:
         return inputs
     at = ks.inputs.index(ks.angle)
     angle = inputs[at]
     if not isinstance(angle, np.ndarray):
         normal = [None, None, None, np.array(ks.unit_normal(angle))]
-    elif _beyond(angle, SINCOS_LIMIT):
+    elif numpy_normal:
         with np.errstate(invalid="ignore"):
             normal = [None, np.cos(angle), np.sin(angle), None]
     else:
@@ -85,32 +96,24 @@ def _driver_columns(ks: KernelSet, inputs: list) -> list:
     return inputs[:at] + normal + inputs[at + 1 :]
 
 
-def _beyond(angle: np.ndarray, limit: float) -> bool:
-    """Whether a finite angle of the column is beyond ±`limit`. Two reductions
-    without temporaries decide almost every batch (fmax/fmin skip NaN); the
-    mask (four passes) only when one of them is beyond: then it may be ±inf,
-    which does not count."""
-    if -limit <= np.fmin.reduce(angle) and np.fmax.reduce(angle) <= limit:
-        return False
-    return bool(np.any(np.isfinite(angle) & (np.abs(angle) > limit)))
-
-
-def _call(driver, columns: list, outs: list) -> None:
+def _call(driver, columns: list, outs: list) -> int:
     """Run `driver` over all rows; scalar columns become filled arrays, a
-    chunk of rows at a time."""
+    chunk of rows at a time. Returns how many finite angles were beyond
+    SINCOS_LIMIT (0 for a driver without an angle loop)."""
     n = outs[-1].shape[0]
     if all(c is None or isinstance(c, np.ndarray) for c in columns):
-        driver(*columns, *outs)
-        return
+        return driver(*columns, *outs) or 0
     scalars = sum(isinstance(c, float) for c in columns)
     size = min(n, max(MIN_CHUNK, FILL_BYTES // (8 * scalars)))
     fills = _fills(columns, size, scalars)
+    beyond = 0
     for start in range(0, n, size):
         stop = min(start + size, n)
         args = [
             _rows_of(c, start, stop, n) if f is None else f[: stop - start] for c, f in zip(columns, fills)
         ]
-        driver(*args, *(o[start:stop] for o in outs))
+        beyond += driver(*args, *(o[start:stop] for o in outs)) or 0
+    return beyond
 
 
 def _rows_of(column: np.ndarray, start: int, stop: int, n: int) -> np.ndarray:

@@ -26,7 +26,7 @@ import numpy as np
 
 from .. import _kernels
 from .._util import CHUNK_SIZE, is_dataframe, row_count, spans
-from ..laws.dispatch import check_names, extra_outputs, integer_extras, is_law_model, law_kernel
+from ..laws.dispatch import check_names, extra_outputs, is_law_model, law_kernel
 from ..scene import CRITICAL
 from .columns import as_column, check_columns, require_mapping
 from .dask_engine import map_chunks
@@ -48,20 +48,14 @@ def _run(ks: _kernels.KernelSet, columns, outputs, placeholders) -> dict:
     n = row_count(columns, names)
     inputs = [0.0 if name in placeholders else as_column(columns, name) for name in ks.inputs]
     outs, status, flags = _kernels.run(ks, inputs, n)
-    return _collect(ks, outs, status, flags, outputs, n)
+    return _collect(outs, status, flags, outputs)
 
 
-def _collect(ks, outs, status, flags, outputs, n) -> dict:
-    """The requested outputs of a kernel run: computed, constant (e_m = 1:
-    M = 0) or absent from the model (particles: yaw, M) → the constant or 0,
-    NaN on rows that were not solved."""
-    filled = [name for name in outputs if name not in outs]
-    # The mask only when a quantity is filled in and a row failed.
-    failed = (status != 0) if filled and status.any() else None
-    result = {
-        name: outs[name] if name in outs else _filler(failed, n, ks.constants.get(name, 0.0))
-        for name in outputs
-    }
+def _collect(outs, status, flags, outputs) -> dict:
+    """The requested outputs of a kernel run (its driver writes every output
+    of the model's tier: computed, or a constant such as e_m = 1's M = 0 and
+    particles' W1 = 0, NaN on a failed row), then status and flags."""
+    result = {name: outs[name] for name in outputs}
     result["status"], result["flags"] = status, flags
     return result
 
@@ -197,10 +191,11 @@ def _solve_group(columns, model: str, critical: bool, names, tier: str, mixed: b
 
 def _solve_law(columns, model: str, names) -> dict:
     """Rows of an impact law (impactsym.laws): its registry kernel, run as a
-    forward group is, with the law's extra output (``sliding``, ``slip_class``)."""
+    forward group is, with the law's extra output (``sliding``, ``slip_class``:
+    int64, -1 on a failed row)."""
     ks = law_kernel(model)
     check_names(columns)
-    return integer_extras(ks, _run(ks, columns, names + extra_outputs(ks), ()))
+    return _run(ks, columns, names + extra_outputs(ks), ())
 
 
 def _is_critical(mu) -> bool:
@@ -278,13 +273,3 @@ def _matches(column, value) -> bool:
         )
     arr = np.asarray(column, dtype=float)
     return bool(np.all((arr == value) | np.isnan(arr)))
-
-
-def _filler(failed: np.ndarray | None, n: int, value: float = 0.0) -> np.ndarray:
-    """A quantity that is a fixed number on every solved row (e_m = 1: M = 0;
-    particles: no yaw, no moment), NaN on the `failed` rows (None: no row
-    failed). Zeros come from np.zeros: fresh zero pages, not a pass over memory."""
-    out = np.zeros(n) if value == 0.0 else np.full(n, value)
-    if failed is not None:
-        out[failed] = np.nan
-    return out

@@ -12,9 +12,9 @@ from __future__ import annotations
 
 from .._kernels import KernelSet
 from ._door import extra_outputs, kernel
-from .kernels import DEFAULT_LAW, LAWS, check_names, integer_extras
+from .kernels import DEFAULT_LAW, LAWS, check_names
 
-__all__ = ["split", "is_law_model", "law_kernel", "extra_outputs", "check_names", "integer_extras"]
+__all__ = ["split", "is_law_model", "law_kernel", "extra_outputs", "check_names"]
 
 
 def split(model) -> tuple[str, str] | None:

@@ -16,8 +16,6 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 
-import numpy as np
-
 from .. import _kernels
 from ._door import LAWS, every_law_column, extra_outputs, kernel
 
@@ -28,7 +26,6 @@ __all__ = [
     "columns_of",
     "solve_one",
     "check_names",
-    "integer_extras",
 ]
 
 DEFAULT_LAW = {"kudlich_slibar": "full", "coulomb": "newton"}  # conventions.md defaults
@@ -69,11 +66,3 @@ def check_names(columns: Mapping) -> None:
             raise ValueError(f"columns: {key!r} is not read by the impact laws ({_NOT_READ[key]})")
         if key not in known:
             raise ValueError(f"columns: unknown column {key!r} (the laws read {' '.join(known)})")
-
-
-def integer_extras(ks: _kernels.KernelSet, out: dict) -> dict:
-    """The law's extra outputs (``sliding``, ``slip_class``) as int64, -1 on a failed row."""
-    for key in extra_outputs(ks):
-        column = out[key]
-        out[key] = np.where(np.isfinite(column), column, -1).astype(np.int64)
-    return out
