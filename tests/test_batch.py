@@ -116,6 +116,7 @@ def test_any_mix_of_scalars_and_arrays_uses_one_compiled_signature():
     c = _rigid(300, seed=5)
     ks = _kernels.kernel_for("rigid", False)
     reference = impactsym.solve_batch(c)
+    signatures = set(ks.driver.signatures)  # other tests may have compiled other forms
     for scalars in (("m1", "m2", "I1", "I2"), ("e", "mu", "e_m"), ("r1x", "w2")):
         mixed = {k: (float(v[0]) if k in scalars else v) for k, v in c.items()}
         same = {k: (np.full(300, v[0]) if k in scalars else v) for k, v in c.items()}
@@ -123,7 +124,7 @@ def test_any_mix_of_scalars_and_arrays_uses_one_compiled_signature():
         for name in OUTPUTS:
             np.testing.assert_array_equal(out[name], want[name], err_msg=f"{scalars} {name}")
     assert (reference["status"] == 0).all()
-    assert len(ks.driver.signatures) == 1
+    assert set(ks.driver.signatures) == signatures
 
 
 def test_scalars_are_filled_chunk_by_chunk(monkeypatch):
