@@ -134,6 +134,7 @@ def kernel(name: str) -> KernelSet:
     )
 
 
+@cache
 def family(name: str) -> tuple[KernelSet, ...]:
     """Every kernel of a family, in registry order (the general one first)."""
     return tuple(kernel(k) for k, row in TABLE.KERNELS.items() if row["family"] == name)

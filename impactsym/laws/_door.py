@@ -9,13 +9,17 @@ an output list.
 
 from __future__ import annotations
 
+from functools import cache
+
 from .. import _kernels
 from .._kernels import registry
 
 #: The registry variant key that names a law in each law family.
 LAW_KEY = {"kudlich_slibar": "contact", "coulomb": "restitution_law"}
-#: model -> its laws, in registry order (K–S: its contacts).
-LAWS = {model: tuple(registry.members(model, key)) for model, key in LAW_KEY.items()}
+#: model -> {law: its kernel}, in registry order (K–S: its contacts).
+_KERNELS = {model: registry.members(model, key) for model, key in LAW_KEY.items()}
+#: model -> its laws, in registry order.
+LAWS = {model: tuple(kernels) for model, kernels in _KERNELS.items()}
 
 
 def kernel(model: str, law: str) -> _kernels.KernelSet:
@@ -24,7 +28,7 @@ def kernel(model: str, law: str) -> _kernels.KernelSet:
         raise ValueError(f"model: unknown impact law model {model!r} (use {', '.join(LAWS)})")
     if law not in LAWS[model]:
         raise ValueError(f"{model}: unknown law {law!r} (use {', '.join(LAWS[model])})")
-    return registry.members(model, LAW_KEY[model])[law]
+    return _KERNELS[model][law]
 
 
 def extra_outputs(ks: _kernels.KernelSet) -> tuple[str, ...]:
@@ -32,6 +36,7 @@ def extra_outputs(ks: _kernels.KernelSet) -> tuple[str, ...]:
     return tuple(name for name in ks.outputs if name not in _kernels.OUTPUTS)
 
 
+@cache
 def every_law_column() -> tuple[str, ...]:
     """The batch columns any law reads."""
     return tuple(dict.fromkeys(c for model in LAWS for law in LAWS[model] for c in kernel(model, law).inputs))
