@@ -144,9 +144,8 @@ def run_one(ks: KernelSet, values: dict, outputs: tuple[str, ...]) -> dict:
     """Run one scene through a kernel's per-scene function (plain Python: no
     numba, no compile).
 
-    Returns every name of `outputs` (the kernel's constant, or 0.0 for a
-    quantity the kernel's model does not have; NaN on a failed row) plus int
-    `status` and `flags`."""
+    Returns every name of `outputs` (computed, or the kernel's constant; NaN
+    on a failed row) plus int `status` and `flags`."""
     args = [float(values[name]) for name in ks.inputs]
     if ks.angle is not None:
         at = ks.inputs.index(ks.angle)
@@ -155,7 +154,6 @@ def run_one(ks: KernelSet, values: dict, outputs: tuple[str, ...]) -> dict:
     result = dict(zip(ks.outputs, outs))
     for name in outputs:
         if name not in result:
-            value = ks.constants.get(name, 0.0)
-            result[name] = value if status == 0 else math.nan
+            result[name] = ks.constants[name] if status == 0 else math.nan
     result["status"], result["flags"] = int(status), int(flags)
     return result
