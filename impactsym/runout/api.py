@@ -14,10 +14,16 @@ import math
 from ..errors import SceneError
 from . import via
 from .batch import columns, run_row, status_text
-from .fit import fit_rest
+from .fit import determination, fit_rest
 from .scene import RunoutScene, RunoutVehicle, load_runout, row_values
 
 PATH_POINTS = 100_000
+# A rest pose read from a scene plan is rarely better than READING (0.1 m of
+# position, 1 degree of heading). A fitted separation quantity that such a
+# misreading moves by more than LOOSE (speed m/s, direction deg, yaw rate
+# rad/s) is named in the warnings as loosely determined by the rest pose.
+READING = (0.1, 1.0)
+LOOSE = {"speed": 1.0, "direction": 10.0, "yaw_rate": 0.5}
 
 
 def runout(scene, path: bool = False, tol: float | None = None) -> dict:
@@ -88,11 +94,58 @@ def _vehicle(sc: RunoutScene, v: RunoutVehicle, index: int, path: bool, tol, war
             names = {"fl": "front_left", "fr": "front_right", "rl": "rear_left", "rr": "rear_right"}
             residual["marks"] = {names[k]: abs(math.degrees(d)) for k, d in zip(v.marks, fit.marks)}
         entry["fit"] = {"residual": residual, "iterations": fit.iterations, "converged": fit.converged}
+        D = determination(v, fit)
+        if D is not None:
+            entry["fit"]["determination"] = _determination(D, vx, vy, length)
+            warnings.extend(_loose(entry["fit"]["determination"], sc, index, v.name, length))
     elif residual:
         entry["residual"] = residual
     if path:
         entry["path"] = [[p[0], p[1] / length, p[2] / length, math.degrees(p[3])] for p in pts]
     return entry
+
+
+def _determination(D, vx: float, vy: float, length: float) -> dict:
+    """The fit's `determination`: how much the fitted separation speed [scene
+    length/s], direction [deg] and yaw rate [rad/s] move per scene length unit
+    of rest position (in its worst direction) and per degree of rest heading,
+    from D = d(vx, vy, w)/d(x, y, psi)_rest (SI, `fit.determination`). The
+    direction is None for a fitted state without translation."""
+    speed = math.hypot(vx, vy)
+    rows = {"yaw_rate": D[2]}
+    if speed > 0.0:
+        rows["speed"] = (vx * D[0] + vy * D[1]) / speed
+        rows["direction"] = (vx * D[1] - vy * D[0]) / speed**2
+    # per scene unit of position: length metres; a speed in scene units is SI / length
+    position = {"speed": 1.0, "direction": math.degrees(length), "yaw_rate": length}
+    heading = {"speed": math.radians(1.0) / length, "direction": 1.0, "yaw_rate": math.radians(1.0)}
+    return {
+        "per_position": {k: _per(rows, k, position, slice(0, 2)) for k in LOOSE},
+        "per_heading": {k: _per(rows, k, heading, slice(2, 3)) for k in LOOSE},
+    }
+
+
+def _per(rows: dict, key: str, unit: dict, cols: slice) -> float | None:
+    return float(math.hypot(*rows[key][cols]) * unit[key]) if key in rows else None
+
+
+def _loose(d: dict, sc: RunoutScene, index: int, name: str, length: float) -> list[str]:
+    """Warnings for the fitted quantities a rest pose misread by READING moves by more than LOOSE."""
+    position = READING[0] / length  # in scene units
+    units = {"speed": f"{_unit(sc)}/s", "direction": "deg", "yaw_rate": "rad/s"}
+    out = []
+    for key, bound in LOOSE.items():
+        by_position, by_heading = d["per_position"][key], d["per_heading"][key]
+        if by_position is None:
+            continue
+        moves = (by_position * position, by_heading * READING[1])
+        if max(moves) * (length if key == "speed" else 1.0) > bound:
+            out.append(
+                f"vehicles[{index}] ({name}): the rest pose determines the separation {key.replace('_', ' ')} "
+                f"only loosely: {position:.2g} {_unit(sc)} of rest position moves it by {moves[0]:.2g} "
+                f"{units[key]}, {READING[1]:g} deg of rest heading by {moves[1]:.2g} {units[key]}"
+            )
+    return out
 
 
 def _unit(sc: RunoutScene) -> str:

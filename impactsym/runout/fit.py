@@ -109,6 +109,7 @@ class Fit:
         default_factory=list
     )  # per intermediate pose: (position miss [m], heading miss [rad] or None)
     cost: float = math.inf  # squared norm of the weighted residual (rest, marks, poses)
+    jacobian: np.ndarray | None = None  # of the weighted residual (rows as in _evaluate) at the state
 
 
 def _wheel_table(row: dict):
@@ -270,7 +271,22 @@ def _newton(vehicle: RunoutVehicle, start, tol, budget: int, coarse: float = 1.0
         marks=[float(x) / scale for x in r[3 : 3 + len(vehicle.marks)]],
         via=via.misses(vehicle.via, r[3 + len(vehicle.marks) :], scale),
         cost=float(r @ r),
+        jacobian=J,
     )
+
+
+def determination(vehicle: RunoutVehicle, fit: Fit) -> np.ndarray | None:
+    """d(vx, vy, w)/d(x_rest, y_rest, psi_rest) at a converged fit (SI, per
+    metre and per radian): how far the fitted separation state moves for a
+    misread rest pose. A rest pose moved by dT moves the residual's rest rows
+    by -E dT (E = diag(1, 1, R_max), the heading row's weight), and the
+    least-squares state by pinv(J) E dT, J the residual's Jacobian at the fit
+    (J^-1 E for the rest pose alone; with marks or intermediate poses the
+    Gauss-Newton step, first order where the residual is not zero). None if
+    the fit did not converge."""
+    if fit.jacobian is None or not fit.converged:
+        return None
+    return np.linalg.pinv(fit.jacobian)[:, :3] * np.array([1.0, 1.0, _radius(vehicle.row)])
 
 
 def _yaw_candidates(w: float) -> list[float]:
