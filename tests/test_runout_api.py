@@ -303,3 +303,35 @@ def test_loosely_determined_yaw_rate_is_named_in_the_warnings():
     tbone = runout(ROOT / "examples" / "runout" / "fit_tbone.json")
     assert not [w for w in tbone["warnings"] if "loosely" in w]
     assert all(set(v["fit"]["determination"]) == {"per_position", "per_heading"} for v in tbone["vehicles"])
+
+
+def test_determination_in_us_units_says_the_same_in_feet():
+    """The T-bone in US units: a rest pose misread by 0.1 m and 1 deg moves the
+    striking car's fitted speed by the same m/s (reported in ft/s), its
+    direction and yaw rate by the same amounts (1 %), and the table prints
+    that line. (The struck car rolls for 5.8 s on four rolling wheels: its
+    heading column moves by 15 % between the SI and US fits, states 5e-6 rad/s
+    apart, from the integrated sensitivities' noise, docs/runout.md.)"""
+    from impactsym.runout.api import misreading
+    from impactsym.runout.cli import table
+
+    si = json.loads((ROOT / "examples" / "runout" / "fit_tbone.json").read_text())
+    us = copy.deepcopy(si)
+    ft, slug = 0.3048, 14.59390293720636
+    us["units"] = "US"
+    us["runout"]["gravity"] = 9.80665 / ft
+    for v in us["vehicles"]:
+        v["mass"] /= slug
+        v["yaw_inertia"] /= slug * ft**2
+        for key in ("wheelbase", "cg_to_front_axle", "track"):
+            v[key] /= ft
+        v["separation"]["position"] = [p / ft for p in v["separation"]["position"]]
+        v["rest"]["position"] = [p / ft for p in v["rest"]["position"]]
+    a, b = runout(si), runout(us)
+    for va, vb in zip(a["vehicles"][:1], b["vehicles"][:1]):
+        ma = misreading(va["fit"]["determination"], "SI")
+        mb = misreading(vb["fit"]["determination"], "US")
+        assert [x * ft for x in mb["speed"]] == pytest.approx(ma["speed"], rel=0.01)
+        assert mb["direction"] == pytest.approx(ma["direction"], rel=0.01)
+        assert mb["yaw_rate"] == pytest.approx(ma["yaw_rate"], rel=0.01)
+    assert "a rest pose 0.33 ft / 1 deg off moves the fit by: speed" in table(b)

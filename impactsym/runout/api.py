@@ -15,7 +15,7 @@ from ..errors import SceneError
 from . import via
 from .batch import columns, run_row, status_text
 from .fit import determination, fit_rest
-from .scene import RunoutScene, RunoutVehicle, load_runout, row_values
+from .scene import FT, RunoutScene, RunoutVehicle, load_runout, row_values
 
 PATH_POINTS = 100_000
 # A rest pose read from a scene plan is rarely better than READING (0.1 m of
@@ -129,21 +129,33 @@ def _per(rows: dict, key: str, unit: dict, cols: slice) -> float | None:
     return float(math.hypot(*rows[key][cols]) * unit[key]) if key in rows else None
 
 
+def misreading(determination: dict, units: str) -> dict:
+    """Per fitted quantity (speed [scene length/s], direction [deg], yaw rate
+    [rad/s]): (how far a rest position READING[0] metres off moves it, how far
+    a rest heading READING[1] degrees off does), from the fit's
+    `determination`; None where the fitted state has no direction."""
+    length = FT if units == "US" else 1.0
+    return {
+        key: None
+        if determination["per_position"][key] is None
+        else (
+            determination["per_position"][key] * READING[0] / length,
+            determination["per_heading"][key] * READING[1],
+        )
+        for key in LOOSE
+    }
+
+
 def _loose(d: dict, sc: RunoutScene, index: int, name: str, length: float) -> list[str]:
     """Warnings for the fitted quantities a rest pose misread by READING moves by more than LOOSE."""
-    position = READING[0] / length  # in scene units
     units = {"speed": f"{_unit(sc)}/s", "direction": "deg", "yaw_rate": "rad/s"}
     out = []
-    for key, bound in LOOSE.items():
-        by_position, by_heading = d["per_position"][key], d["per_heading"][key]
-        if by_position is None:
-            continue
-        moves = (by_position * position, by_heading * READING[1])
-        if max(moves) * (length if key == "speed" else 1.0) > bound:
+    for key, moves in misreading(d, sc.units).items():
+        if moves is not None and max(moves) * (length if key == "speed" else 1.0) > LOOSE[key]:
             out.append(
                 f"vehicles[{index}] ({name}): the rest pose determines the separation {key.replace('_', ' ')} "
-                f"only loosely: {position:.2g} {_unit(sc)} of rest position moves it by {moves[0]:.2g} "
-                f"{units[key]}, {READING[1]:g} deg of rest heading by {moves[1]:.2g} {units[key]}"
+                f"only loosely: {READING[0] / length:.2g} {_unit(sc)} of rest position moves it by "
+                f"{moves[0]:.2g} {units[key]}, {READING[1]:g} deg of rest heading by {moves[1]:.2g} {units[key]}"
             )
     return out
 

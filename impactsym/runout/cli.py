@@ -12,7 +12,8 @@ import json
 from ..errors import SceneError
 from ..residue import without_json_residue
 from ..result import json_clean, table_cell
-from .api import runout
+from .api import READING, misreading, runout
+from .scene import FT
 
 HELP = "post-impact run-out: each vehicle from separation to rest, or its separation velocity fitted to rest"
 
@@ -169,6 +170,17 @@ def table(result: dict) -> str:
             lines.append(
                 f"  residual against the measured rest: {res['position']:.2g} {unit}, "
                 f"{res['heading']:.2g} deg{extra}"
+            )
+        if "determination" in v.get("fit", {}):
+            moves = misreading(v["fit"]["determination"], result["units"])
+            shown = ", ".join(
+                f"{key.replace('_', ' ')} {m[0]:.2g} / {m[1]:.2g} {u}"
+                for (key, m), u in zip(moves.items(), (f"{unit}/s", "deg", "rad/s"))
+                if m is not None
+            )
+            reading = READING[0] / (FT if unit == "ft" else 1.0)
+            lines.append(
+                f"  a rest pose {reading:.2g} {unit} / {READING[1]:g} deg off moves the fit by: {shown}"
             )
     lines += [f"warning: {w}" for w in result["warnings"]]
     return "\n".join(lines)
