@@ -248,3 +248,55 @@ def test_a_scene_run_out_and_its_batch_row_agree_within_the_integrator_error():
         assert status == 0
         assert math.hypot(y[0] - out["x_rest"][i], y[1] - out["y_rest"][i]) < 1e-3
         assert abs(y[2] - out["psi_rest"][i]) < math.radians(0.01)
+
+
+def test_rolling_wheel_shortcut_past_saturation_equals_the_clip():
+    """The forward rolling wheel skips atan2 where its slip angle is past
+    saturation (derive/runout.py, SaturatingPrinter): its (Fx, Fy, Mz) equal
+    the Jacobian kernel's forces (printed with the plain clip) within 1e-13 of
+    the force scale (mu N, and the round-off of u_l over max(|u_l|, eps)), on
+    4,000 random states: half anywhere, half at the saturation boundary (a
+    slip angle of cap alpha_max up to round-off, or within 0.1 % of it)."""
+    from impactsym.runout._door import jit
+
+    k = jit()
+    rng = np.random.default_rng(23)
+    saturated = unsaturated = 0
+    for i in range(4000):
+        psi, delta = rng.uniform(-math.pi, math.pi), rng.uniform(-0.5, 0.5)
+        amax, brake = rng.uniform(0.02, 1.5), rng.choice([0.0, 1.0, rng.uniform(0, 1)])
+        cap = math.sqrt((1 - brake) * (1 + brake))
+        ul = rng.choice([0.0, 1e-4, rng.uniform(-20, 20)])
+        near = 1e-14 if i % 4 == 1 else 1e-3  # at the boundary up to round-off, or within 0.1 %
+        us = math.tan(cap * amax) * max(abs(ul), k.EPS) * (1 + rng.uniform(-near, near))
+        us = us * rng.choice([-1, 1]) if i % 2 else rng.uniform(-20, 20)
+        # the contact point of the wheel at (1.2, 0.75), yawing at 0.3 rad/s, moves at (ul, us)
+        # in the wheel frame (axis at psi + delta): v = u - w (-ry, rx), r in the scene frame
+        a, w = psi + delta, 0.3
+        rx = 1.2 * math.cos(psi) - 0.75 * math.sin(psi)
+        ry = 1.2 * math.sin(psi) + 0.75 * math.cos(psi)
+        vx = ul * math.cos(a) - us * math.sin(a) + w * ry
+        vy = ul * math.sin(a) + us * math.cos(a) - w * rx
+        args = (math.cos(psi), math.sin(psi), vx, vy, w, 1.2, 0.75)
+        args += (
+            math.cos(delta),
+            math.sin(delta),
+            3500.0,
+            0.8,
+            amax,
+            brake,
+            0.0 if brake else 0.012,
+            cap,
+            k.EPS,
+        )
+        fast = np.array(k._wheel_rolling(*args, math.tan(cap * amax)))
+        plain_clip = np.array(k._wheel_rolling_jac(*args)[:3])
+        # the two kernels form u_l in different orders: a round-off of the contact
+        # speeds' size in u_l moves the force by that over max(|u_l|, eps) times mu N
+        scale = 3500.0 * 0.8 * (1.0 + (abs(ul) + abs(us) + 10.0) / max(abs(ul), k.EPS))
+        assert np.abs(fast - plain_clip).max() <= 1e-13 * scale, (i, fast, plain_clip)
+        if abs(us) >= math.tan(cap * amax) * max(abs(ul), k.EPS):
+            saturated += 1
+        else:
+            unsaturated += 1
+    assert saturated > 1000 and unsaturated > 500
