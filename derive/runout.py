@@ -639,9 +639,8 @@ class RunoutPrinter(emit.KernelPrinter):
 class SaturatingPrinter(RunoutPrinter):
     """RunoutPrinter for the forward rolling wheel: Clip(atan2(u_s, h)/alpha_max, cap)
     is printed as cap sgn(u_s) where |u_s| >= tl h (tl = tan(cap alpha_max), the
-    saturated side: no atan2 there; a scratch copy of the kernel ran the mixed
-    example's SUV rows 18 % and its sedan rows 5 % faster), else as the clip.
-    Both forms agree wherever the test decides (`_saturation_claims`)."""
+    saturated side: no atan2 there; measured in docs/runout.md), else as the
+    clip. Both forms agree wherever the test decides (`_saturation_claims`)."""
 
     def _print_Clip(self, expr):
         z, k = expr.args

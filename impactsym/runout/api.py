@@ -109,8 +109,8 @@ def _determination(D, vx: float, vy: float, length: float) -> dict:
     """The fit's `determination`: how much the fitted separation speed [scene
     length/s], direction [deg] and yaw rate [rad/s] move per scene length unit
     of rest position (in its worst direction) and per degree of rest heading,
-    from D = d(vx, vy, w)/d(x, y, psi)_rest (SI, `fit.determination`). The
-    direction is None for a fitted state without translation."""
+    from D = d(vx, vy, w)/d(x, y, psi)_rest (SI, `fit.determination`). Speed
+    and direction are None for a fitted state without translation."""
     speed = math.hypot(vx, vy)
     rows = {"yaw_rate": D[2]}
     if speed > 0.0:
@@ -129,17 +129,21 @@ def _per(rows: dict, key: str, unit: dict, cols: slice) -> float | None:
     return float(math.hypot(*rows[key][cols]) * unit[key]) if key in rows else None
 
 
+def reading(units: str) -> float:
+    """READING's position in scene length units (0.1 m, or 0.33 ft)."""
+    return READING[0] / (FT if units == "US" else 1.0)
+
+
 def misreading(determination: dict, units: str) -> dict:
     """Per fitted quantity (speed [scene length/s], direction [deg], yaw rate
     [rad/s]): (how far a rest position READING[0] metres off moves it, how far
     a rest heading READING[1] degrees off does), from the fit's
     `determination`; None where the fitted state has no direction."""
-    length = FT if units == "US" else 1.0
     return {
         key: None
         if determination["per_position"][key] is None
         else (
-            determination["per_position"][key] * READING[0] / length,
+            determination["per_position"][key] * reading(units),
             determination["per_heading"][key] * READING[1],
         )
         for key in LOOSE
@@ -154,7 +158,7 @@ def _loose(d: dict, sc: RunoutScene, index: int, name: str, length: float) -> li
         if moves is not None and max(moves) * (length if key == "speed" else 1.0) > LOOSE[key]:
             out.append(
                 f"vehicles[{index}] ({name}): the rest pose determines the separation {key.replace('_', ' ')} "
-                f"only loosely: {READING[0] / length:.2g} {_unit(sc)} of rest position moves it by "
+                f"only loosely: {reading(sc.units):.2g} {_unit(sc)} of rest position moves it by "
                 f"{moves[0]:.2g} {units[key]}, {READING[1]:g} deg of rest heading by {moves[1]:.2g} {units[key]}"
             )
     return out

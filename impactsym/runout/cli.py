@@ -12,8 +12,7 @@ import json
 from ..errors import SceneError
 from ..residue import without_json_residue
 from ..result import json_clean, table_cell
-from .api import READING, misreading, runout
-from .scene import FT
+from .api import READING, misreading, reading, runout
 
 HELP = "post-impact run-out: each vehicle from separation to rest, or its separation velocity fitted to rest"
 
@@ -178,9 +177,9 @@ def table(result: dict) -> str:
                 for (key, m), u in zip(moves.items(), (f"{unit}/s", "deg", "rad/s"))
                 if m is not None
             )
-            reading = READING[0] / (FT if unit == "ft" else 1.0)
             lines.append(
-                f"  a rest pose {reading:.2g} {unit} / {READING[1]:g} deg off moves the fit by: {shown}"
+                f"  a rest pose {reading(result['units']):.2g} {unit} / {READING[1]:g} deg off "
+                f"moves the fit by: {shown}"
             )
     lines += [f"warning: {w}" for w in result["warnings"]]
     return "\n".join(lines)
