@@ -47,7 +47,7 @@ MODEL_MODULES = (
     "coulomb",
 )
 # Proved before emission but emitting no module of their own (emit inlines their source).
-PROOF_ONLY_MODULES = ("trig",)
+PROOF_ONLY_MODULES = ("trig", "load_transfer")
 # Emitted without numba batch drivers: the linear method evaluates a Jacobian
 # once per scene with the plain-Python function, and a driver returning the
 # 100-300 outputs of a Jacobian does not compile (numba has no LIST_TO_TUPLE,

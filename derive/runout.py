@@ -62,7 +62,7 @@ import random
 import mpmath
 import sympy as sp
 
-from . import emit
+from . import emit, load_transfer
 
 EPS = 0.0005  # m/s, smoothing speed of sgn and |.| (see the module docstring)
 V_STOP = 1e-3  # m/s, |v| + |w| R_max below which the vehicle is at rest
@@ -114,34 +114,43 @@ STATUS = {
     "RUNOUT_BAD_TYRE": 21,
     "RUNOUT_NOT_STOPPED": 22,
     "RUNOUT_BAD_WHEEL": 23,
+    "RUNOUT_WHEEL_LIFT": 24,
 }
 STATUS_TEXT = {
     1: "a non-finite input",
     2: "mass or yaw inertia not > 0",
-    20: "wheelbase, cg_to_front_axle or track out of range (need 0 < a < L, track > 0)",
+    20: "wheelbase, cg_to_front_axle, track or cg_height out of range (need 0 < a < L, track > 0, h >= 0)",
     21: "friction, slip_angle_max, rolling_resistance or gravity out of range",
     22: "still moving at the time limit (no resisting force?)",
     23: "a wheel state not 0/1, brake not in [0, 1] or steer not in (-90, 90) deg",
+    24: "cg_height too high for the friction: load transfer could lift a wheel "
+    "(need sqrt(mu^2 + f_r^2) h sqrt(1 + (2 b/track)^2) < b, b = L - a, and the same with a at the rear)",
 }
 
 WHEELS = ("fl", "fr", "rl", "rr")
 COLUMNS = (
-    "m",
-    "I",
-    "L",
-    "a",
-    "track",
-    "mu",
-    "alpha_max",
-    "f_r",
-    "g",
-    "x",
-    "y",
-    "psi",
-    "vx",
-    "vy",
-    "w",
-) + tuple(f"{kind}_{k}" for k in WHEELS for kind in ("state", "brake", "steer"))
+    (
+        "m",
+        "I",
+        "L",
+        "a",
+        "track",
+        "mu",
+        "alpha_max",
+        "f_r",
+        "g",
+        "x",
+        "y",
+        "psi",
+        "vx",
+        "vy",
+        "w",
+    )
+    + tuple(f"{kind}_{k}" for k in WHEELS for kind in ("state", "brake", "steer"))
+    + ("h",)
+)
+# h: the centre of gravity's height, 0 for the contract's static loads (> 0: quasi-static
+# load transfer, derive/load_transfer.py); appended so that the other columns keep their places.
 OUTPUTS = ("x_rest", "y_rest", "psi_rest", "t", "distance", "status", "steps")
 # Sensitivity columns: d(x_rest, y_rest, psi_rest)/d(vx, vy, w, mu) at separation.
 SENSITIVITIES = tuple(f"d{o}_d{p}" for o in ("x", "y", "psi") for p in ("vx", "vy", "w", "mu"))
@@ -761,6 +770,9 @@ def render_plain(digest: str) -> str:
         "",
         "",
         via_functions().rstrip("\n"),
+        "",
+        "",
+        load_transfer.limit_function().rstrip("\n"),
     ]
     return "\n".join(parts) + "\n"
 
@@ -812,17 +824,23 @@ def _sensitivity_lines() -> str:
             f"        f[{7 + 4 * 1 + j}] = {sj[4]}",
             f"        f[{7 + 4 * 2 + j}] = {sj[5]}",
         ]
-        for row, (acc, div) in enumerate((("x", "m"), ("y", "m"), ("z", "inertia"))):
-            terms = " + ".join(f"d{acc}{k}*{sj[2 + k]}" for k in range(4))
-            extra = f" + d{acc}4" if j == 3 else ""
+        for row, div in enumerate(("m", "m", "inertia")):
+            terms = " + ".join(f"d{'xyz'[row]}{k}*{sj[2 + k]}" for k in range(4))
+            extra = f" + d{'xyz'[row]}4" if j == 3 else ""
             lines.append(f"        f[{7 + 4 * (3 + row) + j}] = ({terms}{extra})/{div}")
     return "\n".join(lines)
 
 
 INTEGRATOR_SOURCE = '''
 
-# Per-row tables built by _setup: P = (m, I, mu, alpha_max, eps, R_max) and
-# W[k] = (px, py, cos delta, sin delta, N, b, f, cap, locked, tan(cap alpha_max)) for k = fl, fr, rl, rr.
+# Per-row tables built by _setup: P = (m, I, mu, alpha_max, eps, R_max, h) and
+# W[k] = (px, py, cos delta, sin delta, N, b, f, cap, locked, tan(cap alpha_max), c_l, c_s)
+# for k = fl, fr, rl, rr (c_l, c_s: the load change per newton of force along and across the
+# vehicle, derive/load_transfer.py). A row with h > 0 runs through the _lt functions
+# (TRANSFER_SOURCE) and its own row functions and batch driver, which numba
+# compiles only when such a row comes: the static model's code and first use
+# stay as they were (the transfer inside _rhs, _rhs_sens and _jac cost 1.2 s
+# of every first fit).
 
 
 @__JIT__
@@ -885,7 +903,7 @@ __ACC_ADD__
 __SENS__
 
 
-@__JIT__
+__TRANSFER__@__JIT__
 def _speed(y, P):
     """|v| + |w| R_max: the fastest any wheel can move."""
     return math.sqrt(y[3]*y[3] + y[4]*y[4]) + abs(y[5])*P[5]
@@ -899,7 +917,7 @@ def _check(v):
             return STATUS_NONFINITE_INPUT
     if not (v[0] > 0.0 and v[1] > 0.0):
         return STATUS_BAD_MASS
-    if not (v[2] > 0.0 and v[3] > 0.0 and v[3] < v[2] and v[4] > 0.0):
+    if not (v[2] > 0.0 and v[3] > 0.0 and v[3] < v[2] and v[4] > 0.0 and v[27] >= 0.0):
         return STATUS_RUNOUT_BAD_GEOMETRY
     if not (v[5] > 0.0 and v[6] > 0.0 and v[6] < 0.5*math.pi and v[7] >= 0.0 and v[8] > 0.0):
         return STATUS_RUNOUT_BAD_TYRE
@@ -907,6 +925,7 @@ def _check(v):
         state, brake, steer = v[15 + 3*k], v[16 + 3*k], v[17 + 3*k]
         if not ((state == 0.0 or state == 1.0) and brake >= 0.0 and brake <= 1.0 and abs(steer) < 0.5*math.pi):
             return STATUS_RUNOUT_BAD_WHEEL
+__LIFT__
     return STATUS_OK
 
 
@@ -918,10 +937,12 @@ def _setup(v, eps):
     m, inertia, wb, a, track, mu, amax, f_r, g = v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8]
     b_ = wb - a
     half = 0.5*track
-    W = np.empty((4, 10))
+    W = np.empty((4, 12))
     xs = (a, a, -b_, -b_)
     ys = (half, -half, half, -half)
     loads = (m*g*b_/(2.0*wb), m*g*b_/(2.0*wb), m*g*a/(2.0*wb), m*g*a/(2.0*wb))
+    # load change per newton of body-frame force (derive/load_transfer.py; 0 when h = 0)
+__TRANSFER_SETUP__
     for k in range(4):
         state, brake, steer = v[15 + 3*k], v[16 + 3*k], v[17 + 3*k]
         W[k, 0] = xs[k]
@@ -934,9 +955,12 @@ def _setup(v, eps):
         W[k, 7] = math.sqrt((1.0 - brake)*(1.0 + brake))
         W[k, 8] = state
         W[k, 9] = math.tan(W[k, 7]*amax)
-    P = np.empty(6)
+        W[k, 10] = cl[k]
+        W[k, 11] = cs[k]
+    P = np.empty(7)
     P[0], P[1], P[2], P[3], P[4] = m, inertia, mu, amax, eps
     P[5] = math.sqrt(max(a, b_)**2 + half*half)
+    P[6] = v[27]
     return P, W
 
 
@@ -986,7 +1010,7 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
         steps += 1
         if stiff:
             if not fresh:
-                _jac(y, P, W, J)
+                _jac__LT__(y, P, W, J)
                 fresh = True
             stiff = h*_stiffness(J, P[5]) >= W_LEAVE
             if not (stiff or taken):  # handed straight back: look again W_WAIT steps later
@@ -1236,6 +1260,116 @@ def _w_stage(K, i, fz, h, hg, J, Q, ex, ey, g):
 
 
 '''
+TRANSFER_SOURCE = '''@__JIT__
+def _transfer_forces(c, s, vx, vy, w, P, W):
+    """Quasi-static load transfer (a row's h > 0, derive/load_transfer.py): each
+    wheel at unit load gives H_k; G = sum N0_k H_k and A = sum H_k d_k', d_k =
+    R(psi) (c_l, c_s)_k; returns (Fx, Fy, Mz) of (I - A) F = G, Mz = Gz + A_z . F
+    (_transfer_solve), then A's six entries."""
+    mu, amax, eps = P[2], P[3], P[4]
+    gx = 0.0
+    gy = 0.0
+    gz = 0.0
+    a00 = 0.0
+    a01 = 0.0
+    a10 = 0.0
+    a11 = 0.0
+    a20 = 0.0
+    a21 = 0.0
+    for k in range(4):
+        px, py, cd, sd, n = W[k, 0], W[k, 1], W[k, 2], W[k, 3], W[k, 4]
+        b, fre, cap = W[k, 5], W[k, 6], W[k, 7]
+        if W[k, 8] != 0.0:
+            r = _wheel_locked(c, s, vx, vy, w, px, py, cd, sd, 1.0, mu, amax, b, fre, cap, eps)
+        else:
+            r = _wheel_rolling(c, s, vx, vy, w, px, py, cd, sd, 1.0, mu, amax, b, fre, cap, eps, W[k, 9])
+        dkx = c*W[k, 10] - s*W[k, 11]
+        dky = s*W[k, 10] + c*W[k, 11]
+        gx += n*r[0]
+        gy += n*r[1]
+        gz += n*r[2]
+        a00 += r[0]*dkx
+        a01 += r[0]*dky
+        a10 += r[1]*dkx
+        a11 += r[1]*dky
+        a20 += r[2]*dkx
+        a21 += r[2]*dky
+    fx, fy, mz = _transfer_solve(a00, a01, a10, a11, a20, a21, gx, gy, gz)
+    return fx, fy, mz, a00, a01, a10, a11, a20, a21
+
+
+@__JIT__
+def _transferred(c, s, q, W):
+    """W with each wheel's load moved to N_k = N0_k + d_k . F (q from _transfer_forces)."""
+    Wn = W.copy()
+    for k in range(4):
+        Wn[k, 4] += (c*W[k, 10] - s*W[k, 11])*q[0] + (s*W[k, 10] + c*W[k, 11])*q[1]
+    return Wn
+
+
+__TRANSFER_KERNELS__
+
+
+@__JIT__
+def _rhs_lt(y, P, W, f):
+    """_rhs under quasi-static load transfer (_transfer_forces)."""
+    c = math.cos(y[2])
+    s = math.sin(y[2])
+    vx, vy, w = y[3], y[4], y[5]
+    q = _transfer_forces(c, s, vx, vy, w, P, W)
+    f[0] = vx
+    f[1] = vy
+    f[2] = w
+    f[3] = q[0]/P[0]
+    f[4] = q[1]/P[0]
+    f[5] = q[2]/P[1]
+    f[6] = math.sqrt(vx*vx + vy*vy)
+
+
+@__JIT__
+def _rhs_sens_lt(y, P, W, f):
+    """_rhs_lt and its sensitivity equations: _rhs_sens with the wheels at the
+    solved loads gives D S (D = sum N_k dH_k, S the sensitivities); the
+    transfer's share enters through the solve column by column, dF = M^-1 (D S
+    + e dpsi/dp) (_transfer_d with turn = dpsi/dp_j = S[2, j]: the load changes
+    turn with the heading). The static model's code, reused: its own written-out
+    copy cost 1.3 s of a transferring scene's first use."""
+    c = math.cos(y[2])
+    s = math.sin(y[2])
+    q = _transfer_forces(c, s, y[3], y[4], y[5], P, W)
+    _rhs_sens(y, P, _transferred(c, s, q, W), f)
+    f[3] = q[0]/P[0]
+    f[4] = q[1]/P[0]
+    f[5] = q[2]/P[1]
+    for j in range(4):
+        ax, ay, az = _transfer_d(
+            q[3], q[4], q[5], q[6], q[7], q[8], q[0], q[1],
+            f[19 + j]*P[0], f[23 + j]*P[0], f[27 + j]*P[1], y[15 + j],
+        )
+        f[19 + j] = ax/P[0]
+        f[23 + j] = ay/P[0]
+        f[27 + j] = az/P[1]
+
+
+@__JIT__
+def _jac_lt(y, P, W, J):
+    """_jac under load transfer: _jac at the solved loads, each column through
+    the solve (_transfer_d; the heading's column also turns the load changes)."""
+    c = math.cos(y[2])
+    s = math.sin(y[2])
+    q = _transfer_forces(c, s, y[3], y[4], y[5], P, W)
+    _jac(y, P, _transferred(c, s, q, W), J)
+    for col in range(4):
+        turn = 1.0 if col == 0 else 0.0
+        ax, ay, az = _transfer_d(
+            q[3], q[4], q[5], q[6], q[7], q[8], q[0], q[1], J[0, col]*P[0], J[1, col]*P[0], J[2, col]*P[1], turn
+        )
+        J[0, col] = ax/P[0]
+        J[1, col] = ay/P[0]
+        J[2, col] = az/P[1]
+
+
+'''
 ROW_TEMPLATE = '''@__JIT__
 def runout_row__SUFFIX__(v, tol, eps, path):
     """One run-out: v the COLUMNS values (SI, radians). Returns (y, t, status,
@@ -1257,8 +1391,8 @@ __SINIT__    t, status, steps, points = _integrate__SUFFIX__(y, P, W, tol, path)
 
 '''
 BATCH_TEMPLATE = '''@__DECORATOR__
-def runout_batch(c, lo, hi, out_x_rest, out_y_rest, out_psi_rest, out_t, out_distance, out_status, out_steps, tol, eps):
-    """Rows lo..hi-1 of the (rows, COLUMNS) input table c through runout_row.
+def runout_batch__SUFFIX__(c, lo, hi, out_x_rest, out_y_rest, out_psi_rest, out_t, out_distance, out_status, out_steps, tol, eps):
+    """Rows lo..hi-1 of the (rows, COLUMNS) input table c through runout_row__SUFFIX__.
     One serial loop that releases the GIL: the runtime runs chunks of rows on
     threads (impactsym/runout/batch.py). It replaced a prange driver and its
     serial twin: the same run-outs per second on two threads, one compile (a
@@ -1266,7 +1400,7 @@ def runout_batch(c, lo, hi, out_x_rest, out_y_rest, out_psi_rest, out_t, out_dis
     after runout_row)."""
     empty = np.empty((0, 4))
     for i in range(lo, hi):
-        y, t, status, steps, _ = runout_row(c[i], tol, eps, empty)
+        y, t, status, steps, _ = runout_row__SUFFIX__(c[i], tol, eps, empty)
         out_x_rest[i] = y[0]
         out_y_rest[i] = y[1]
         out_psi_rest[i] = y[2]
@@ -1284,7 +1418,7 @@ def _path_writes(template: str, suffix: str) -> str:
     impactsym/runout/via.py). Two forms, not the loop in both: with the loop
     the forward batch ran 5-9 % fewer run-outs a second (28,000-28,600 against
     29,500-31,000 on the locked Monte Carlo's rows)."""
-    if suffix:
+    if "sens" in suffix:
         first = "path[0, 0] = 0.0\n        for i in range(min(path.shape[1] - 1, n)):\n            path[0, 1 + i] = y[i]"
         nxt = (
             "path[points, 0] = t\n            for i in range(min(path.shape[1] - 1, n)):\n"
@@ -1301,45 +1435,72 @@ def _path_writes(template: str, suffix: str) -> str:
 
 
 ACC = [f"d{a}{k}" for a in "xyz" for k in range(5)]
-INTEGRATOR_SOURCE = (
-    INTEGRATOR_SOURCE.replace("__JIT__", JIT)
-    .replace("__ACC_INIT__", "\n".join(f"    {name} = 0.0" for name in ACC))
-    .replace(
-        "__ACC_ADD__",
-        "\n".join(
-            ["        fx += r[0]", "        fy += r[1]", "        mz += r[2]"]
-            + [f"        {name} += r[{3 + i}]" for i, name in enumerate(ACC)]
-        ),
+# Integrator variants: (suffix, right-hand side's suffix, Jacobian's): forward and with
+# sensitivities, each with static loads and with load transfer (TRANSFER_SOURCE).
+VARIANTS = ("", "_sens", "_lt", "_sens_lt")
+
+
+def _acc_add() -> str:
+    """_rhs_sens: the sums of one wheel result r."""
+    return "\n".join(
+        ["        fx += r[0]", "        fy += r[1]", "        mz += r[2]"]
+        + [f"        {name} += r[{3 + i}]" for i, name in enumerate(ACC)]
     )
+
+
+def _rows() -> str:
+    """runout_row__SUFFIX__ for every variant (with sensitivities: nogil, 31 states)."""
+    out = []
+    for suffix in VARIANTS:
+        text = ROW_TEMPLATE.replace("__SUFFIX__", suffix)
+        if "sens" in suffix:
+            # nogil: the fit runs its uniqueness starts on threads (impactsym/runout/fit.py)
+            text = (
+                text.replace("@__JIT__", "@" + JIT[:-1] + ", nogil=True)")
+                .replace("__N__", "31")
+                .replace(
+                    "__DOC__",
+                    ", then the sensitivities S[i, j] = d y_i/d p_j at y[7 + 4 i + j], "
+                    "p = (vx, vy, w at separation, mu)",
+                )
+                .replace(
+                    "__SINIT__",
+                    "    y[7 + 4*3 + 0] = 1.0\n    y[7 + 4*4 + 1] = 1.0\n    y[7 + 4*5 + 2] = 1.0\n",
+                )
+            )
+        else:
+            text = text.replace("__N__", "7").replace("__DOC__", "").replace("__SINIT__", "")
+        out.append(text)
+    return "\n\n".join(out)
+
+
+INTEGRATOR_SOURCE = (
+    INTEGRATOR_SOURCE.replace("__TRANSFER__", TRANSFER_SOURCE)
+    .replace("__TRANSFER_KERNELS__", load_transfer.kernel_source(JIT, PRINTER))
+    .replace("__LIFT__", "\n".join(load_transfer.check_lines(PRINTER)))
+    .replace("__TRANSFER_SETUP__", "\n".join(load_transfer.setup_lines(PRINTER)))
+    .replace("__JIT__", JIT)
+    .replace("__ACC_INIT__", "\n".join(f"    {name} = 0.0" for name in ACC))
+    .replace("__ACC_ADD__", _acc_add())
     .replace("__SENS__", "\n".join(line[4:] for line in _sensitivity_lines().splitlines()))
     .replace(
         "__INTEGRATE__",
         W_SOURCE
         + "".join(
-            (WSTEP_TEMPLATE + "\n\n" + _path_writes(INTEGRATE_TEMPLATE, suffix)).replace("__SUFFIX__", suffix)
+            (WSTEP_TEMPLATE + "\n\n" + _path_writes(INTEGRATE_TEMPLATE, suffix))
+            .replace("__SUFFIX__", suffix)
+            .replace("__LT__", "_lt" if "lt" in suffix else "")
             + "\n\n"
-            for suffix in ("", "_sens")
+            for suffix in VARIANTS
         ),
     )
+    .replace("__ROW__", _rows())
     .replace(
-        "__ROW__",
-        ROW_TEMPLATE.replace("__SUFFIX__", "")
-        .replace("__N__", "7")
-        .replace("__DOC__", "")
-        .replace("__SINIT__", "")
-        + "\n\n"
-        + ROW_TEMPLATE.replace("__SUFFIX__", "_sens")
-        # nogil: the fit runs its uniqueness starts on threads (impactsym/runout/fit.py)
-        .replace("@__JIT__", "@" + JIT[:-1] + ", nogil=True)")
-        .replace("__N__", "31")
-        .replace(
-            "__DOC__",
-            ", then the sensitivities S[i, j] = d y_i/d p_j at y[7 + 4 i + j], p = (vx, vy, w at separation, mu)",
-        )
-        .replace(
-            "__SINIT__", "    y[7 + 4*3 + 0] = 1.0\n    y[7 + 4*4 + 1] = 1.0\n    y[7 + 4*5 + 2] = 1.0\n"
+        "__BATCH__",
+        "\n\n".join(
+            BATCH_TEMPLATE.replace("__DECORATOR__", JIT[:-1] + ", nogil=True)").replace("__SUFFIX__", suffix)
+            for suffix in ("", "_lt")
         ),
     )
-    .replace("__BATCH__", BATCH_TEMPLATE.replace("__DECORATOR__", JIT[:-1] + ", nogil=True)"))
     .replace("__JIT__", JIT)
 )

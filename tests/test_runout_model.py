@@ -16,7 +16,7 @@ import pytest
 
 from impactsym.runout import runout_batch
 from impactsym.runout._door import plain
-from impactsym.runout.batch import columns, run_row
+from impactsym.runout.batch import input_table, run_row
 from tests.runout_rows import realistic_row, rows_table
 
 G = 9.80665
@@ -48,7 +48,7 @@ def _row(state: float, **kw) -> dict:
 
 
 def _one(row, **kw):
-    return run_row(np.array([row[c] for c in columns()]), **kw)
+    return run_row(input_table(row)[0], **kw)
 
 
 @pytest.mark.parametrize("speed", [5.0, 20.0, 35.0])
@@ -244,7 +244,7 @@ def test_a_scene_run_out_and_its_batch_row_agree_within_the_integrator_error():
     rows = [realistic_row(rng) for _ in range(40)]
     out = runout_batch(rows_table(rows))
     for i, row in enumerate(rows):
-        y, _, status, _, _ = run_row(np.array([row[c] for c in columns()]))
+        y, _, status, _, _ = run_row(input_table(row)[0])
         assert status == 0
         assert math.hypot(y[0] - out["x_rest"][i], y[1] - out["y_rest"][i]) < 1e-3
         assert abs(y[2] - out["psi_rest"][i]) < math.radians(0.01)

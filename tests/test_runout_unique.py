@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pytest
 
-from impactsym.runout.batch import columns, run_row
+from impactsym.runout.batch import input_table, run_row
 from impactsym.runout.fit import DISTINCT_SPEED, DISTINCT_YAW, fit_rest
 from impactsym.runout.scene import RunoutVehicle
 from tests.runout_rows import realistic_row
@@ -28,7 +28,7 @@ def _round_trip(index: int):
     rng = np.random.default_rng(5)
     rows = [realistic_row(rng) for _ in range(index + 1)]
     row = rows[index]
-    y, _, status, _, _ = run_row(np.array([row[c] for c in columns()]))
+    y, _, status, _, _ = run_row(input_table(row)[0])
     assert status == 0
     fixed = {k: v for k, v in row.items() if k not in ("vx", "vy", "w")}
     rest = (float(y[0]), float(y[1]), float(y[2]))
@@ -39,7 +39,7 @@ def _reaches(row: dict, state, rest) -> bool:
     """`state` = (vx, vy, w), run forward at the default tolerance, stops within
     1 mm and 0.01 deg of `rest`."""
     values = dict(row, vx=state[0], vy=state[1], w=state[2])
-    y, _, status, _, _ = run_row(np.array([values[c] for c in columns()]))
+    y, _, status, _, _ = run_row(input_table(values)[0])
     return status == 0 and math.hypot(y[0] - rest[0], y[1] - rest[1]) < 1e-3 and abs(y[2] - rest[2]) < 1.75e-4
 
 
@@ -77,7 +77,7 @@ def test_a_unique_slide_names_no_other_state():
     vehicle.row.update({f"state_{k}": 1.0 for k in ("fl", "fr", "rl", "rr")})
     vehicle.row.update({f"brake_{k}": 0.0 for k in ("fl", "fr", "rl", "rr")})
     values = dict(vehicle.row, vx=9.0, vy=-4.0, w=0.8)
-    y, _, _, _, _ = run_row(np.array([values[c] for c in columns()]))
+    y, _, _, _, _ = run_row(input_table(values)[0])
     vehicle.rest = (float(y[0]), float(y[1]), float(y[2]))
     fit = fit_rest(vehicle)
     assert fit.converged and fit.alternatives == []

@@ -22,7 +22,7 @@ import pytest
 from impactsym.errors import SceneError
 from impactsym.runout import load_runout, runout
 from impactsym.runout import via as V
-from impactsym.runout.batch import columns, run_row
+from impactsym.runout.batch import columns, input_table, run_row
 from impactsym.runout.fit import fit_rest
 from impactsym.runout.scene import RunoutVehicle
 from tests.helpers import run_cli_subprocess
@@ -43,11 +43,10 @@ def _path(values, tol=None):
 
 def _rows(n: int, seed: int):
     rng = np.random.default_rng(seed)
-    cols = columns()
     out = []
     for _ in range(n):
         row = realistic_row(rng)
-        out.append((row, np.array([row[c] for c in cols])))
+        out.append((row, input_table(row)[0]))
     return out
 
 
@@ -140,7 +139,7 @@ def test_an_intermediate_pose_picks_the_generating_state_of_two():
     names it, and the other (which misses the pose) is no alternative."""
     rng = np.random.default_rng(5)
     row = [realistic_row(rng) for _ in range(2)][1]
-    values = np.array([row[c] for c in columns()])
+    values = input_table(row)[0]
     y, _, _, _, path = run_row(values, path_points=V.PATH_ROWS, path_columns=8)
     mid = path[path.shape[0] // 2]
     fixed = {k: v for k, v in row.items() if k not in ("vx", "vy", "w")}

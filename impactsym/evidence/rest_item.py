@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import SceneError, show_value
-from ..runout import fit_rest, load_runout
+from ..runout import chain, fit_rest, load_runout
 from ..runout.fit import Fit, newton
 from ..runout.interval import separation_sensitivity
 from ..runout.scene import RunoutVehicle
@@ -46,7 +46,7 @@ from ..scene.casefile import LeafReader, check_keys
 from .items import Observation, vehicle_index
 
 #: A fit vehicle's keys that only a rest item reads (the run-out's chassis and tyres).
-RUNOUT_VEHICLE_KEYS = ("wheelbase", "cg_to_front_axle", "track", "wheels", "separation", "friction")
+RUNOUT_VEHICLE_KEYS = tuple(key for key in chain.RUNOUT_VEHICLE_KEYS if key != "rest")
 POSE_KEYS = ("position", "heading")
 NONLINEAR = 0.2  # sd of the separation state: a linearisation departing more is named
 LABELS = ("Vx", "Vy", "W")

@@ -80,6 +80,8 @@ def _vehicle(sc: RunoutScene, v: RunoutVehicle, index: int, path: bool, tol, war
             "yaw_rate": w,
         },
     }
+    if v.row.get("h", 0.0) > 0.0:  # the model used: quasi-static load transfer
+        entry["cg_height"] = v.row["h"] / length
     residual = {}
     if v.rest is not None:
         residual["position"] = math.hypot(y[0] - v.rest[0], y[1] - v.rest[1]) / length

@@ -3,8 +3,9 @@
 Columns (conventions.md, "Post-impact run-out"): ``m I L a track mu alpha_max f_r g
 x y psi vx vy w`` and per wheel k in ``fl fr rl rr``: ``state_k`` (0 rolling, 1
 locked), ``brake_k`` (0..1), ``steer_k`` (rad). ``alpha_max`` (default 10 deg in
-rad), ``f_r`` (0.01), ``g`` (9.80665) and the wheel columns (0) may be left out:
-the documented defaults of a scene file. Outputs ``x_rest y_rest psi_rest``
+rad), ``f_r`` (0.01), ``g`` (9.80665), ``h`` (the centre of gravity's height [m];
+0: the contract's static wheel loads, > 0: quasi-static load transfer) and the
+wheel columns (0) may be left out: the documented defaults of a scene file. Outputs ``x_rest y_rest psi_rest``
 (psi unwrapped) ``t distance status steps``; a row with ``status != 0`` has NaN
 outputs (codes: :data:`STATUS_TEXT`) and the other rows are unaffected.
 """
@@ -18,7 +19,7 @@ import numpy as np
 from ..errors import SceneError
 from . import _door, threads
 
-DEFAULTS = {"alpha_max": math.radians(10.0), "f_r": 0.01, "g": 9.80665}
+DEFAULTS = {"alpha_max": math.radians(10.0), "f_r": 0.01, "g": 9.80665, "h": 0.0}
 WHEEL_DEFAULT = 0.0
 # Rows per task on the threads: at least CHUNK, and at most TASKS tasks per
 # thread. 32 rows ran as many run-outs per second on two threads as numba's
@@ -77,26 +78,46 @@ def runout_batch(cols, tol: float | None = None, parallel: bool | None = None) -
     (default: more than CHUNK rows), else in the calling thread."""
     table = input_table(cols)
     n = table.shape[0]
-    plain, jit = _door.plain(), _door.jit()
+    plain = _door.plain()
     tol = plain.TOL if tol is None else float(tol)
     out = {name: np.empty(n) for name in ("x_rest", "y_rest", "psi_rest", "t", "distance")}
-    status = np.empty(n, dtype=np.int64)
-    steps = np.empty(n, dtype=np.int64)
-    arrays = (out["x_rest"], out["y_rest"], out["psi_rest"], out["t"], out["distance"], status, steps)
+    out |= {name: np.empty(n, dtype=np.int64) for name in ("status", "steps")}
+    moving = _transferring(table)
+    for driver, rows in (("runout_batch", ~moving), ("runout_batch_lt", moving)):
+        if rows.all():
+            _drive(driver, table, out, tol, parallel)
+        elif rows.any():
+            part = {name: np.empty(int(rows.sum()), dtype=a.dtype) for name, a in out.items()}
+            _drive(driver, np.ascontiguousarray(table[rows]), part, tol, parallel)
+            for name, a in part.items():
+                out[name][rows] = a
+    return out
+
+
+def _transferring(table: np.ndarray) -> np.ndarray:
+    """Rows with quasi-static load transfer (column h > 0): they run through the
+    kernel's _lt drivers, which numba compiles only when such a row comes."""
+    return table[:, columns().index("h")] > 0.0
+
+
+def _drive(driver: str, table: np.ndarray, out: dict, tol: float, parallel: bool | None) -> None:
+    """All rows of `table` through the batch driver `driver`, into the arrays of `out`."""
+    n = table.shape[0]
+    plain, jit = _door.plain(), _door.jit()
+    kernel = getattr(jit, driver)
+    names = ("x_rest", "y_rest", "psi_rest", "t", "distance", "status", "steps")
+    arrays = tuple(out[name] for name in names)
     workers = threads.workers()
     if (parallel if parallel is not None else n > CHUNK) and workers > 1:
         size = max(CHUNK, -(-n // (TASKS * workers)))
         chunks = [
-            threads.pool().submit(jit.runout_batch, table, lo, min(lo + size, n), *arrays, tol, plain.EPS)
+            threads.pool().submit(kernel, table, lo, min(lo + size, n), *arrays, tol, plain.EPS)
             for lo in range(0, n, size)
         ]
         for chunk in chunks:
             chunk.result()
     else:
-        jit.runout_batch(table, 0, n, *arrays, tol, plain.EPS)
-    out["status"] = status
-    out["steps"] = steps
-    return out
+        kernel(table, 0, n, *arrays, tol, plain.EPS)
 
 
 def run_row(
@@ -124,8 +145,10 @@ def run_row(
     forward drivers (`runout_batch`)."""
     plain, jit = _door.plain(), _door.jit()
     buffer = np.empty((path_points, path_columns))
-    y, t, status, steps, points = jit.runout_row_sens(
-        np.ascontiguousarray(values, dtype=np.float64),
+    values = np.ascontiguousarray(values, dtype=np.float64)
+    row = jit.runout_row_sens_lt if _transferring(values[None])[0] else jit.runout_row_sens
+    y, t, status, steps, points = row(
+        values,
         plain.TOL if tol is None else float(tol),
         plain.EPS if eps is None else float(eps),
         buffer,
@@ -135,11 +158,13 @@ def run_row(
 
 def compile_drivers() -> int:
     """Compile (or load from numba's cache) every run-out driver: the batch
-    driver and the row function with sensitivities (`run_row`'s), by running
-    one locked slide through each (``impactsym compile``). Returns how many."""
+    driver and the row function with sensitivities (`run_row`'s), each with
+    static loads and with load transfer, by running one locked slide through
+    each (``impactsym compile``). Returns how many."""
     row = {"m": 1500.0, "I": 2500.0, "L": 2.7, "a": 1.2, "track": 1.5, "mu": 0.7}
     row |= {"x": 0.0, "y": 0.0, "psi": 0.0, "vx": 10.0, "vy": 0.0, "w": 0.0}
     row |= {f"state_{k}": 1.0 for k in ("fl", "fr", "rl", "rr")}
-    runout_batch(row)
-    run_row(input_table(row)[0], sens=True)
-    return 2
+    for h in (0.0, 0.5):  # static loads, then load transfer (the _lt drivers)
+        runout_batch(row | {"h": h})
+        run_row(input_table(row | {"h": h})[0], sens=True)
+    return 4

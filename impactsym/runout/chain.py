@@ -26,7 +26,16 @@ from ..scene import scene_data
 from ..single import solve
 from .api import runout
 
-RUNOUT_VEHICLE_KEYS = ("wheelbase", "cg_to_front_axle", "track", "wheels", "separation", "rest", "friction")
+RUNOUT_VEHICLE_KEYS = (
+    "wheelbase",
+    "cg_to_front_axle",
+    "track",
+    "cg_height",
+    "wheels",
+    "separation",
+    "rest",
+    "friction",
+)
 
 
 def _impact_part(data: Mapping) -> dict:

@@ -163,6 +163,10 @@ def table(result: dict) -> str:
             f"heading {rest['heading']:.2f} deg",
             f"  time {v['time']:.3f} s, distance {v['distance']:.3f} {unit}, rotation {v['rotation']:.2f} deg",
         ]
+        if "cg_height" in v:
+            lines.append(
+                f"  wheel loads: quasi-static load transfer, centre of gravity {v['cg_height']:.3g} {unit} high"
+            )
         res = v.get("fit", v).get("residual")
         if res is not None:
             extra = f", {v['fit']['iterations']} iterations" if "fit" in v else ""

@@ -18,6 +18,8 @@ import numpy as np
 from ..errors import SceneError, show_value
 from ..scene import scene_data
 from ..scene.casefile import check_keys
+from . import _door
+from .batch import DEFAULTS
 
 FT = 0.3048  # m
 SLUG = 14.59390293720636  # kg
@@ -57,6 +59,7 @@ VEHICLE_KEYS = (
     "wheelbase",
     "cg_to_front_axle",
     "track",
+    "cg_height",
     "wheels",
     "separation",
     "rest",
@@ -230,6 +233,7 @@ def _vehicle(v: Mapping, index: int, tyre: dict, centre, units: str, length: flo
     track = _positive(_require(v, "track", p), f"{p}.track")
     wheels = _wheels(_require(v, "wheels", p), f"{p}.wheels")
     mu = _positive(v["friction"], f"{p}.friction") if "friction" in v else tyre["mu"]
+    height = _cg_height(v, p, wb, a, track, mu, tyre["f_r"])
     sep = _mapping(v.get("separation", {}), f"{p}.separation")
     check_keys(sep, SEPARATION_KEYS, f"{p}.separation")
     if "heading" in sep:
@@ -275,6 +279,7 @@ def _vehicle(v: Mapping, index: int, tyre: dict, centre, units: str, length: flo
         "L": wb * length,
         "a": a * length,
         "track": track * length,
+        "h": height * length,
         **tyre,
         "mu": mu,
         "x": pos[0] * length,
@@ -295,6 +300,25 @@ def _vehicle(v: Mapping, index: int, tyre: dict, centre, units: str, length: flo
         marks=marks,
         via=via,
     )
+
+
+def _cg_height(v: Mapping, p: str, wb: float, a: float, track: float, mu: float, f_r: float) -> float:
+    """The optional ``cg_height`` [scene length]: 0 (absent) keeps the contract's
+    static wheel loads; > 0 turns on quasi-static load transfer, refused at or
+    above the height where it could lift a wheel (derive/load_transfer.py)."""
+    if "cg_height" not in v:
+        return 0.0
+    height = _number(v["cg_height"], f"{p}.cg_height")
+    if height < 0.0:
+        raise SceneError(f"must be >= 0 (0: static wheel loads), got {height:g}", f"{p}.cg_height")
+    limit = _door.plain().cg_height_limit(wb, a, track, mu, f_r)
+    if height >= limit:
+        raise SceneError(
+            f"{height:g} is too high for friction {mu:g}: load transfer could lift a wheel "
+            f"(this vehicle's limit is {limit:.3g})",
+            f"{p}.cg_height",
+        )
+    return height
 
 
 def _intermediate(value: Any, path: str, length: float) -> tuple:
@@ -327,6 +351,7 @@ def _marks(value: Any, path: str) -> dict[str, float]:
 def row_values(
     vehicle: RunoutVehicle, columns: tuple[str, ...], vx: float, vy: float, w: float
 ) -> np.ndarray:
-    """The kernel row of `vehicle` with the separation velocity (vx, vy, w) [SI]."""
-    values = dict(vehicle.row, vx=vx, vy=vy, w=w)
+    """The kernel row of `vehicle` with the separation velocity (vx, vy, w) [SI];
+    a column its row leaves out takes the batch's documented default (batch.DEFAULTS)."""
+    values = DEFAULTS | dict(vehicle.row, vx=vx, vy=vy, w=w)
     return np.array([values[c] for c in columns], dtype=np.float64)

@@ -100,6 +100,7 @@ def _nominal_leaves(data: dict, units: str) -> dict:
             continue
         p = f"vehicles[{i}]"
         number(v, "friction", f"{p}.friction", "number", "positive")
+        number(v, "cg_height", f"{p}.cg_height", "length", "nonnegative")
         for block in ("rest", "separation"):
             if isinstance(v.get(block), dict):
                 pair(v[block], "position", f"{p}.{block}.position")
@@ -177,6 +178,8 @@ class Chained:
         heading = values.get(f"{p}.separation.heading")
         row["psi"] = cols[f"theta{num}"] if heading is None else np.deg2rad(heading)
         row["mu"] = values.get(f"{p}.friction", values.get("runout.friction", row["mu"]))
+        if f"{p}.cg_height" in values:
+            row["h"] = values[f"{p}.cg_height"] * length
         if "runout.slip_angle_max" in values:
             row["alpha_max"] = np.deg2rad(values["runout.slip_angle_max"])
         row["f_r"] = values.get("runout.rolling_resistance", row["f_r"])

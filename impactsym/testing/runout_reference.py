@@ -6,6 +6,13 @@ Test support, not runtime code (needs scipy). Same smoothing as the kernels
 (a speed u that divides or gives a sign enters as max(|u|, eps)) and the same
 stop (|v| + |w| R_max < v_stop), so that the comparison measures the
 integrator alone. Inputs are one row of the batch columns as a dict (SI, rad).
+
+Load transfer (a row's ``h`` > 0, the vehicle's cg_height) is written from the
+textbook statement, not from derive's linear solve: the front axle gains
+m h a_l/L of the rear's load (a_l the forward acceleration), the right wheels
+m h a_s/track of the left's (a_s leftward), shared between the axles as their
+static loads are; the loads are found by fixed-point iteration (loads ->
+forces -> acceleration -> loads) to 1e-13 of the weight.
 """
 
 from __future__ import annotations
@@ -46,17 +53,45 @@ def tyre_force(u: np.ndarray, load: float, state: float, brake: float, steer: fl
     return f_l * e_l + f_s * e_s
 
 
+def _body_force(vb, w, row: dict, wheels, loads, eps):
+    """(force in the vehicle frame, moment) with the wheels at `loads`."""
+    force, moment = np.zeros(2), 0.0
+    for (r, _, state, brake, steer), load in zip(wheels, loads):
+        u = vb + w * np.array([-r[1], r[0]])
+        f = tyre_force(u, load, state, brake, steer, row, eps)
+        force += f
+        moment += r[0] * f[1] - r[1] * f[0]
+    return force, moment
+
+
+def transferred_loads(row: dict, wheels, accel) -> list[float]:
+    """Wheel loads under quasi-static load transfer at body acceleration accel = (a_l, a_s)."""
+    m, h, wb, a, track = row["m"], row.get("h", 0.0), row["L"], row["a"], row["track"]
+    pitch = m * h * accel[0] / wb  # load the front axle gains from the rear when a_l < 0
+    roll = m * h * accel[1] / track  # load the right wheels gain from the left
+    shares = ((wb - a) / wb,) * 2 + (a / wb,) * 2  # the axles' static shares
+    sides = (-1, 1, -1, 1)  # fl, fr, rl, rr: left loses, right gains
+    axle = (-0.5, -0.5, 0.5, 0.5)
+    return [w[1] + axle[k] * pitch + sides[k] * shares[k] * roll for k, w in enumerate(wheels)]
+
+
 def rhs(t, y, row: dict, wheels, eps=EPS):
     """d/dt (x, y, psi, vx, vy, w, distance)."""
     psi, vx, vy, w = y[2], y[3], y[4], y[5]
     c, s = math.cos(psi), math.sin(psi)
     vb = np.array([c * vx + s * vy, -s * vx + c * vy])
-    force, moment = np.zeros(2), 0.0
-    for r, load, state, brake, steer in wheels:
-        u = vb + w * np.array([-r[1], r[0]])
-        f = tyre_force(u, load, state, brake, steer, row, eps)
-        force += f
-        moment += r[0] * f[1] - r[1] * f[0]
+    loads = [wheel[1] for wheel in wheels]
+    force, moment = _body_force(vb, w, row, wheels, loads, eps)
+    if row.get("h", 0.0) > 0.0:
+        for _ in range(200):
+            loads = transferred_loads(row, wheels, force / row["m"])
+            new, moment = _body_force(vb, w, row, wheels, loads, eps)
+            done = np.abs(new - force).max() < 1e-13 * row["m"] * row["g"]
+            force = new
+            if done:
+                break
+        else:
+            raise RuntimeError("load transfer did not converge")
     fx, fy = c * force[0] - s * force[1], s * force[0] + c * force[1]
     return [vx, vy, w, fx / row["m"], fy / row["m"], moment / row["I"], math.hypot(vx, vy)]
 
