@@ -23,6 +23,7 @@ import contextlib
 import importlib.util
 import json
 import math
+import os
 import subprocess
 import sys
 import tempfile
@@ -56,6 +57,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--via-only",
         action="store_true",
         help="only the round trips with an intermediate pose (printed, nothing written)",
+    )
+    parser.add_argument(
+        "--transfer-only",
+        action="store_true",
+        help="only load transfer against static loads: batch and first use (printed, nothing written)",
     )
 
 
@@ -225,6 +231,78 @@ def _throughput(n: int, versions) -> dict:
                 best[v.label] = min(best[v.label], time.perf_counter() - start)
             assert (out["status"] == 0).all()
     return {label: n / seconds for label, seconds in best.items()}
+
+
+def _transfer_throughput(n: int) -> dict:
+    """Run-outs per second of the parallel batch on `n` random rows with load transfer
+    (h drawn in [0.4, 0.6] m, the _lt kernels) and on the same rows with static loads
+    (h = 0), alternating, best of REPEATS; after one call each (first use)."""
+    from impactsym.runout import runout_batch
+    from tests.runout_rows import realistic_row, rows_table
+
+    rng = np.random.default_rng(11)
+    rows = [realistic_row(rng) for _ in range(n)]
+    heights = rng.uniform(0.4, 0.6, n)
+    tables = {
+        "static": rows_table(rows),
+        "transfer": rows_table([r | {"h": h} for r, h in zip(rows, heights)]),
+    }
+    best = dict.fromkeys(tables, math.inf)
+    for table in tables.values():
+        runout_batch(table)
+    for _ in range(REPEATS):
+        for label, table in tables.items():
+            start = time.perf_counter()
+            out = runout_batch(table)
+            best[label] = min(best[label], time.perf_counter() - start)
+            assert (out["status"] == 0).all()
+    rates = {label: n / seconds for label, seconds in best.items()}
+    return rates | {"ratio": rates["transfer"] / rates["static"]}
+
+
+_FIRST_USE = (
+    "import json, sys, time; t = time.perf_counter(); import impactsym; "
+    "impactsym.runout(json.loads(sys.argv[1])); print(time.perf_counter() - t)"
+)
+
+
+def _first_use() -> dict:
+    """Seconds of import + impactsym.runout on examples/runout/fit_tbone.json (both cars
+    fitted to rest) in a fresh process with an empty numba cache: as given (static
+    loads) and with cg_height 0.55 m on both cars (the _lt kernels), alternating, twice."""
+    scene = json.loads((Path(__file__).resolve().parents[1] / "examples/runout/fit_tbone.json").read_text())
+    moved = json.loads(json.dumps(scene))
+    for v in moved["vehicles"]:
+        v["cg_height"] = 0.55
+    out = {"static": [], "transfer": []}
+    for _ in range(2):
+        for label, data in (("static", scene), ("transfer", moved)):
+            with tempfile.TemporaryDirectory() as cache:
+                proc = subprocess.run(
+                    [sys.executable, "-c", _FIRST_USE, json.dumps(data)],
+                    capture_output=True,
+                    text=True,
+                    env=dict(os.environ, NUMBA_CACHE_DIR=cache),
+                    timeout=600,
+                    check=True,
+                )
+            out[label].append(float(proc.stdout.strip().splitlines()[-1]))
+    return out
+
+
+def _transfer_line(t: dict) -> str:
+    line = (
+        f"Load transfer (cg_height, h in [0.4, 0.6] m): {t['transfer']:.0f} run-outs/s against "
+        f"{t['static']:.0f} with static loads on the same rows, ratio {t['ratio']:.2f}."
+    )
+    if "first_use_s" in t:
+        f = t["first_use_s"]
+        line += (
+            " First use (fit_tbone.json, empty numba cache, fresh process): static "
+            f"{', '.join(f'{x:.2f}' for x in f['static'])} s, with cg_height "
+            f"{', '.join(f'{x:.2f}' for x in f['transfer'])} s."
+        )
+    return line
 
 
 FIT_CASES = ("all locked", "front locked, rear rolling", "sedan.json: locked, rolling, braked 0.5, steered")
@@ -444,7 +522,6 @@ def _values(row: dict) -> np.ndarray:
 
 
 def main(args: argparse.Namespace) -> int:
-    import os
 
     from impactsym.testing.runout_reference import reference_runout
     from tests.runout_rows import realistic_row
@@ -452,6 +529,9 @@ def main(args: argparse.Namespace) -> int:
     if args.via_only:
         _fit_random_via(2)  # first use
         print(_via_line(_fit_random_via(args.fits)))
+        return 0
+    if args.transfer_only:
+        print(_transfer_line(_transfer_throughput(args.batch) | {"first_use_s": _first_use()}))
         return 0
     load_before = os.getloadavg()
     rng = np.random.default_rng(2024)
@@ -484,6 +564,7 @@ def main(args: argparse.Namespace) -> int:
             "solve_ivp_RK45": ivp,
             "ratios_at_equal_error": ratios,
             "runouts_per_second_parallel": _throughput(args.batch, versions),
+            "load_transfer": _transfer_throughput(args.batch) | {"first_use_s": _first_use()},
             "runouts_per_second_one_thread_default_tol": {
                 label: 1.0 / next(p for p in curve if p["tol"] == 1e-8)["seconds_per_runout"]
                 for label, curve in kernel.items()
@@ -616,4 +697,6 @@ def _markdown(r: dict) -> str:
         )
     if "fit_random_via" in r:
         lines.append(_via_line(r["fit_random_via"]))
+    if "load_transfer" in r:
+        lines.append(_transfer_line(r["load_transfer"]))
     return "\n".join(lines) + "\n"

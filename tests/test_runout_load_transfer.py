@@ -95,11 +95,18 @@ def test_random_runouts_agree_with_the_fixed_point_reference():
     rows = _random_rows(77, 8)
     out = runout_batch(rows_table(rows))
     assert (out["status"] == 0).all()
+    worst = [0.0, 0.0]
     for i, row in enumerate(rows):
         x, y, psi, _, dist = reference_runout(row)
         allowed = 1e-3 + 1e-5 * dist
-        assert math.hypot(out["x_rest"][i] - x, out["y_rest"][i] - y) < allowed, i
-        assert abs(math.degrees(out["psi_rest"][i] - psi)) < 0.01, i
+        miss, turn = (
+            math.hypot(out["x_rest"][i] - x, out["y_rest"][i] - y),
+            abs(math.degrees(out["psi_rest"][i] - psi)),
+        )
+        worst = [max(worst[0], miss), max(worst[1], turn)]
+        assert miss < allowed, i
+        assert turn < 0.01, i
+    print(f"\nload transfer vs the fixed-point reference, 8 rows: worst {worst[0]:.2g} m, {worst[1]:.2g} deg")
 
 
 def _values(row: dict) -> np.ndarray:
@@ -123,7 +130,9 @@ def test_sensitivities_match_central_differences(i):
             ym, *_ = run_row(_values(moved), tol=1e-12)
             rest.append(ym[:3])
         fd = (rest[0] - rest[1]) / (2 * steps[name])
-        assert np.linalg.norm(S[:, j] - fd) < 5e-3 * np.linalg.norm(fd), (name, S[:, j], fd)
+        error = np.linalg.norm(S[:, j] - fd) / np.linalg.norm(fd)
+        print(f"\nrow {i}, d rest/d {name}: relative error {error:.2g}")
+        assert error < 5e-3, (name, S[:, j], fd)
 
 
 def test_the_lift_limit_is_the_kernels_refusal():
