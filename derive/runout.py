@@ -813,6 +813,22 @@ def render(digest: str) -> dict[str, str]:
     return {"runout.py": render_plain(digest), "runout_jit.py": "\n".join(parts).rstrip("\n") + "\n"}
 
 
+def _wheel_call(load: str, jacobian: bool) -> str:
+    """The loop body that reads wheel k's row of W and evaluates its force (and
+    with `jacobian` its derivatives) at normal load `load` into r."""
+    kind = "_jac" if jacobian else ""
+    tail = "" if jacobian else ", W[k, 9]"  # the forward rolling wheel's saturation threshold
+    args = f"c, s, vx, vy, w, px, py, cd, sd, {load}, mu, amax, b, fre, cap, eps"
+    return (
+        "        px, py, cd, sd, n = W[k, 0], W[k, 1], W[k, 2], W[k, 3], W[k, 4]\n"
+        "        b, fre, cap = W[k, 5], W[k, 6], W[k, 7]\n"
+        "        if W[k, 8] != 0.0:\n"
+        f"            r = _wheel_locked{kind}({args})\n"
+        "        else:\n"
+        f"            r = _wheel_rolling{kind}({args}{tail})"
+    )
+
+
 def _sensitivity_lines() -> str:
     """dS/dt = J S (+ df/dmu in the mu column) for the 6 x 4 sensitivity block
     S[i, j] = y[7 + 4 i + j] (j: vx, vy, w at separation, then mu)."""
@@ -855,12 +871,7 @@ def _rhs(y, P, W, f):
     fy = 0.0
     mz = 0.0
     for k in range(4):
-        px, py, cd, sd, n = W[k, 0], W[k, 1], W[k, 2], W[k, 3], W[k, 4]
-        b, fre, cap = W[k, 5], W[k, 6], W[k, 7]
-        if W[k, 8] != 0.0:
-            r = _wheel_locked(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
-        else:
-            r = _wheel_rolling(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps, W[k, 9])
+__WHEEL__
         fx += r[0]
         fy += r[1]
         mz += r[2]
@@ -886,12 +897,7 @@ def _rhs_sens(y, P, W, f):
     mz = 0.0
 __ACC_INIT__
     for k in range(4):
-        px, py, cd, sd, n = W[k, 0], W[k, 1], W[k, 2], W[k, 3], W[k, 4]
-        b, fre, cap = W[k, 5], W[k, 6], W[k, 7]
-        if W[k, 8] != 0.0:
-            r = _wheel_locked_jac(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
-        else:
-            r = _wheel_rolling_jac(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
+__WHEEL_JAC__
 __ACC_ADD__
     f[0] = vx
     f[1] = vy
@@ -1126,12 +1132,7 @@ def _jac(y, P, W, J):
         for col in range(4):
             J[row, col] = 0.0
     for k in range(4):
-        px, py, cd, sd, n = W[k, 0], W[k, 1], W[k, 2], W[k, 3], W[k, 4]
-        b, fre, cap = W[k, 5], W[k, 6], W[k, 7]
-        if W[k, 8] != 0.0:
-            r = _wheel_locked_jac(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
-        else:
-            r = _wheel_rolling_jac(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
+__WHEEL_JAC__
         for row in range(3):
             for col in range(4):
                 J[row, col] += r[3 + 5*row + col]
@@ -1277,12 +1278,7 @@ def _transfer_forces(c, s, vx, vy, w, P, W):
     a20 = 0.0
     a21 = 0.0
     for k in range(4):
-        px, py, cd, sd, n = W[k, 0], W[k, 1], W[k, 2], W[k, 3], W[k, 4]
-        b, fre, cap = W[k, 5], W[k, 6], W[k, 7]
-        if W[k, 8] != 0.0:
-            r = _wheel_locked(c, s, vx, vy, w, px, py, cd, sd, 1.0, mu, amax, b, fre, cap, eps)
-        else:
-            r = _wheel_rolling(c, s, vx, vy, w, px, py, cd, sd, 1.0, mu, amax, b, fre, cap, eps, W[k, 9])
+__WHEEL_UNIT__
         dkx = c*W[k, 10] - s*W[k, 11]
         dky = s*W[k, 10] + c*W[k, 11]
         gx += n*r[0]
@@ -1495,6 +1491,9 @@ INTEGRATOR_SOURCE = (
         ),
     )
     .replace("__ROW__", _rows())
+    .replace("__WHEEL_JAC__", _wheel_call("n", True))
+    .replace("__WHEEL_UNIT__", _wheel_call("1.0", False))
+    .replace("__WHEEL__", _wheel_call("n", False))
     .replace(
         "__BATCH__",
         "\n\n".join(

@@ -38,15 +38,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import SceneError, show_value
-from ..runout import chain, fit_rest, load_runout
+from ..runout import fit_rest, load_runout
 from ..runout.fit import Fit, newton
 from ..runout.interval import separation_sensitivity
+from ..runout.scene import RUNOUT_VEHICLE_KEYS as RUNOUT_KEYS
 from ..runout.scene import RunoutVehicle
 from ..scene.casefile import LeafReader, check_keys
 from .items import Observation, vehicle_index
 
 #: A fit vehicle's keys that only a rest item reads (the run-out's chassis and tyres).
-RUNOUT_VEHICLE_KEYS = tuple(key for key in chain.RUNOUT_VEHICLE_KEYS if key != "rest")
+RUNOUT_VEHICLE_KEYS = tuple(key for key in RUNOUT_KEYS if key != "rest")
 POSE_KEYS = ("position", "heading")
 NONLINEAR = 0.2  # sd of the separation state: a linearisation departing more is named
 LABELS = ("Vx", "Vy", "W")

@@ -25,17 +25,7 @@ from ..reconstruct import reconstruct
 from ..scene import scene_data
 from ..single import solve
 from .api import runout
-
-RUNOUT_VEHICLE_KEYS = (
-    "wheelbase",
-    "cg_to_front_axle",
-    "track",
-    "cg_height",
-    "wheels",
-    "separation",
-    "rest",
-    "friction",
-)
+from .scene import RUNOUT_VEHICLE_KEYS
 
 
 def _impact_part(data: Mapping) -> dict:

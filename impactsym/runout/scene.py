@@ -51,11 +51,8 @@ IMPACT_VEHICLE_KEYS = (
     "length",
     "width",
 )
-VEHICLE_KEYS = (
-    "name",
-    "mass",
-    "yaw_inertia",
-    "heading",
+# A vehicle's run-out keys that the impact commands do not read (chain.py strips them).
+RUNOUT_VEHICLE_KEYS = (
     "wheelbase",
     "cg_to_front_axle",
     "track",
@@ -63,9 +60,16 @@ VEHICLE_KEYS = (
     "wheels",
     "separation",
     "rest",
+    "friction",
+)
+VEHICLE_KEYS = (
+    "name",
+    "mass",
+    "yaw_inertia",
+    "heading",
+    *RUNOUT_VEHICLE_KEYS,
     "intermediate",
     "impact_point",
-    "friction",
     *IMPACT_VEHICLE_KEYS,
 )
 WHEEL_NAMES = ("front_left", "front_right", "rear_left", "rear_right")
