@@ -1328,8 +1328,9 @@ def _rhs_sens_lt(y, P, W, f):
     solved loads gives D S (D = sum N_k dH_k, S the sensitivities); the
     transfer's share enters through the solve column by column, dF = M^-1 (D S
     + e dpsi/dp) (_transfer_d with turn = dpsi/dp_j = S[2, j]: the load changes
-    turn with the heading). The static model's code, reused: its own written-out
-    copy cost 1.3 s of a transferring scene's first use."""
+    turn with the heading). The static model's code, reused: a written-out copy
+    of its own made a transferring fit's first use 0.7 s longer (7.2-7.5 s
+    against 6.5-6.7 s, docs/runout.md)."""
     c = math.cos(y[2])
     s = math.sin(y[2])
     q = _transfer_forces(c, s, y[3], y[4], y[5], P, W)
@@ -1431,8 +1432,8 @@ def _path_writes(template: str, suffix: str) -> str:
 
 
 ACC = [f"d{a}{k}" for a in "xyz" for k in range(5)]
-# Integrator variants: (suffix, right-hand side's suffix, Jacobian's): forward and with
-# sensitivities, each with static loads and with load transfer (TRANSFER_SOURCE).
+# Integrator variants by suffix: forward and with sensitivities, each with static
+# loads and with load transfer ("_lt": _rhs_lt, _rhs_sens_lt, _jac_lt of TRANSFER_SOURCE).
 VARIANTS = ("", "_sens", "_lt", "_sens_lt")
 
 

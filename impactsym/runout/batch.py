@@ -5,9 +5,10 @@ x y psi vx vy w`` and per wheel k in ``fl fr rl rr``: ``state_k`` (0 rolling, 1
 locked), ``brake_k`` (0..1), ``steer_k`` (rad). ``alpha_max`` (default 10 deg in
 rad), ``f_r`` (0.01), ``g`` (9.80665), ``h`` (the centre of gravity's height [m];
 0: the contract's static wheel loads, > 0: quasi-static load transfer) and the
-wheel columns (0) may be left out: the documented defaults of a scene file. Outputs ``x_rest y_rest psi_rest``
-(psi unwrapped) ``t distance status steps``; a row with ``status != 0`` has NaN
-outputs (codes: :data:`STATUS_TEXT`) and the other rows are unaffected.
+wheel columns (0) may be left out: the documented defaults of a scene file.
+Outputs ``x_rest y_rest psi_rest`` (psi unwrapped) ``t distance status steps``;
+a row with ``status != 0`` has NaN outputs (codes: :data:`STATUS_TEXT`) and the
+other rows are unaffected.
 """
 
 from __future__ import annotations
@@ -82,8 +83,8 @@ def runout_batch(cols, tol: float | None = None, parallel: bool | None = None) -
     tol = plain.TOL if tol is None else float(tol)
     out = {name: np.empty(n) for name in ("x_rest", "y_rest", "psi_rest", "t", "distance")}
     out |= {name: np.empty(n, dtype=np.int64) for name in ("status", "steps")}
-    moving = _transferring(table)
-    for driver, rows in (("runout_batch", ~moving), ("runout_batch_lt", moving)):
+    transfer = _transferring(table)
+    for driver, rows in (("runout_batch", ~transfer), ("runout_batch_lt", transfer)):
         if rows.all():
             _drive(driver, table, out, tol, parallel)
         elif rows.any():
