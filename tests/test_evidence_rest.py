@@ -364,3 +364,19 @@ def test_a_friction_given_as_another_distribution_is_a_one_line_error():
     with pytest.raises(SceneError) as info:
         fit(scene, draws=0)
     assert info.value.field == "runout.friction" and "\n" not in str(info.value)
+
+
+def test_rest_poses_with_load_transfer_give_back_the_true_speeds():
+    """cg_height on both cars (quasi-static load transfer): the rest item's fit runs
+    the same run-outs the forward scene ran, so exact rest poses give the speeds back."""
+    chassis = (FRONT_LOCKED | {"cg_height": 0.55}, CHASSIS[1] | {"cg_height": 0.6})
+    scene, t = _rest_scene(3, chassis=chassis)
+    out = fit(scene, draws=0).to_json_dict()
+    static, _ = _rest_scene(3, chassis=(FRONT_LOCKED, CHASSIS[1]))
+    for i in range(2):
+        assert out["vehicles"][i]["speed"] == pytest.approx(t["speeds"][i], abs=1e-3)
+    rests = [
+        [e["value"]["position"] for e in sc["evidence"] if e["quantity"] == "rest"] for sc in (scene, static)
+    ]
+    assert len(rests[0]) == 2
+    assert max(math.dist(a, b) for a, b in zip(*rests)) > 0.05  # the transfer moved the rest poses
