@@ -134,8 +134,9 @@ def solved_forces():
 
 def force_derivatives():
     """(dFx, dFy, dMz) with respect to one of (psi, vx, vy, w, mu): D = sum N_k dH_k
-    (the wheel Jacobians at the transferred loads), turn = 1 for psi (d_k turns
-    with the vehicle: d(d_k)/dpsi = (-d_ky, d_kx)) and 0 otherwise; F the forces."""
+    (the wheel Jacobians at the transferred loads), turn = d psi/dz (d_k turns
+    with the vehicle: d(d_k)/dpsi = (-d_ky, d_kx); 1 for psi, 0 otherwise, and
+    by linearity d psi/dp along a sensitivity column p); F the forces."""
     E = D + turn * sp.Matrix([A[i, 0] * F[1] - A[i, 1] * F[0] for i in range(3)])
     adj, det = _inverse()
     df = adj * E[:2, :] / det
@@ -195,7 +196,8 @@ def kernel_source(jit: str, printer) -> str:
         (*A, *F, *D, turn),
         force_derivatives(),
         "d(Fx, Fy, Mz)/dz under load transfer, D = sum N_k dH_k/dz at the transferred loads,\n"
-        "    turn = 1 for z = psi (d_k turns with the vehicle), else 0 (derive/load_transfer.py).",
+        "    turn = d psi/dz (d_k turns with the vehicle: 1 for z = psi, 0 for vx, vy, w, mu;\n"
+        "    the sensitivity equations pass d psi/dp) (derive/load_transfer.py).",
         jit,
         printer,
     )
