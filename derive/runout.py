@@ -1329,8 +1329,8 @@ def _rhs_sens_lt(y, P, W, f):
     transfer's share enters through the solve column by column, dF = M^-1 (D S
     + e dpsi/dp) (_transfer_d with turn = dpsi/dp_j = S[2, j]: the load changes
     turn with the heading). The static model's code, reused: a written-out copy
-    of its own made a transferring fit's first use 0.7 s longer (7.2-7.5 s
-    against 6.5-6.7 s, docs/runout.md)."""
+    of its own made a transferring fit's first use longer (6.7-7.5 s against
+    6.4-6.7 s, docs/runout.md)."""
     c = math.cos(y[2])
     s = math.sin(y[2])
     q = _transfer_forces(c, s, y[3], y[4], y[5], P, W)
