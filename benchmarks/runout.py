@@ -14,6 +14,7 @@ imported beside the checkout's), interleaved with this checkout's, so the
 before/after ratios do not depend on how loaded the machine was.
 
     python -m benchmarks runout [--rows 6] [--batch 2000] [--against REV] [--out benchmarks/results]
+    python -m benchmarks runout --grid-only [--fits 20]   (the fit with and without the grid search)
 """
 
 from __future__ import annotations
@@ -57,6 +58,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--via-only",
         action="store_true",
         help="only the round trips with an intermediate pose (printed, nothing written)",
+    )
+    parser.add_argument(
+        "--grid-only",
+        action="store_true",
+        help="only the round trips of seeds 5 and 6 fitted without and with the grid search (printed)",
     )
     parser.add_argument(
         "--transfer-only",
@@ -354,8 +360,9 @@ def _fit_timing(versions) -> dict:
     return {"cases": cases}
 
 
-def _fit_random(n: int, version) -> dict:
-    """Round trips on random realistic run-outs: forward, then fitted to the rest
+def _fit_random(n: int, version, seed: int = 5, **options) -> dict:
+    """Round trips on random realistic run-outs (`seed`): forward, then fitted
+    (fit_rest's keyword `options`, e.g. the grid search's) to the rest
     pose reached. Counts fits that converged, that recovered the generating
     state (0.01 m/s, 0.01 rad/s; the reported state or a named alternative),
     that reached the rest pose from another state without naming the
@@ -366,7 +373,7 @@ def _fit_random(n: int, version) -> dict:
     from impactsym.runout.scene import RunoutVehicle
     from tests.runout_rows import realistic_row
 
-    rng = np.random.default_rng(5)
+    rng = np.random.default_rng(seed)
     counts = {"rows": n, "converged": 0, "recovered": 0, "other_state_unnamed": 0, "alternatives": 0}
     counts["spurious_alternatives"] = 0
     times = []
@@ -377,7 +384,7 @@ def _fit_random(n: int, version) -> dict:
             fixed = {k: v for k, v in row.items() if k not in ("vx", "vy", "w")}
             veh = RunoutVehicle("r", fixed, (row["x"], row["y"]), row["psi"], None, None, (y[0], y[1], y[2]))
             start = time.perf_counter()
-            fit = version.fit.fit_rest(veh)
+            fit = version.fit.fit_rest(veh, **options)
             times.append(time.perf_counter() - start)
             found = [fit, *fit.alternatives]
             hit = any(_same(f, (row["vx"], row["vy"], row["w"])) for f in found)
@@ -387,12 +394,7 @@ def _fit_random(n: int, version) -> dict:
             counts["alternatives"] += len(fit.alternatives)
             for i, alt in enumerate(fit.alternatives):
                 ya, _, status, _, _ = run_row(
-                    np.array(
-                        [
-                            dict(row, vx=alt.velocity[0], vy=alt.velocity[1], w=alt.yaw_rate)[c]
-                            for c in _columns()
-                        ]
-                    )
+                    _values(dict(row, vx=alt.velocity[0], vy=alt.velocity[1], w=alt.yaw_rate))
                 )
                 missed = (
                     status != 0
@@ -455,6 +457,22 @@ def _via_line(fv: dict) -> str:
         f"reported the generating state, {fv['alternatives']} alternatives named; median {fv['median_ms']:.1f} ms, "
         f"max {fv['max_ms']:.1f} ms per fit."
     )
+
+
+def _grid_round_trips(n: int) -> None:
+    """The round trips of seeds 5 and 6 (`_fit_random`), fitted as usual and
+    with the grid search (`exhaustive`), this checkout; printed."""
+    now = _versions(None, ROOT)[0]
+    _fit_random(1, now, exhaustive=True)  # first use
+    for seed in (5, 6):
+        for label, options in (("fit", {}), ("fit + grid search", {"exhaustive": True})):
+            c = _fit_random(n, now, seed, **options)
+            print(
+                f"seed {seed}, {label}: {c['rows']} round trips, {c['converged']} converged, {c['recovered']} "
+                f"recovered the generating state, {c['other_state_unnamed']} reached the rest pose from another "
+                f"state without naming it, {c['alternatives']} alternatives named ({c['spurious_alternatives']} "
+                f"spurious); median {c['median_ms']:.0f} ms, max {c['max_ms']:.0f} ms per fit"
+            )
 
 
 def _same(f, p) -> bool:
@@ -529,6 +547,9 @@ def main(args: argparse.Namespace) -> int:
     if args.via_only:
         _fit_random_via(2)  # first use
         print(_via_line(_fit_random_via(args.fits)))
+        return 0
+    if args.grid_only:
+        _grid_round_trips(args.fits)
         return 0
     if args.transfer_only:
         print(_transfer_line(_transfer_throughput(args.batch) | {"first_use_s": _first_use()}))

@@ -41,3 +41,29 @@ def realistic_row(rng: np.random.Generator) -> dict:
 def rows_table(rows: list[dict]) -> dict:
     """Columns of a list of rows."""
     return {key: np.array([r[key] for r in rows]) for key in rows[0]}
+
+
+def round_trip(index: int, seed: int = 5):
+    """(row, rest pose reached, vehicle to fit) of row `index` of the benchmark's
+    round trips (`realistic_row` with `seed`): the vehicle without its separation state."""
+    from impactsym.runout.batch import input_table, run_row
+    from impactsym.runout.scene import RunoutVehicle
+
+    rng = np.random.default_rng(seed)
+    rows = [realistic_row(rng) for _ in range(index + 1)]
+    row = rows[index]
+    y, _, status, _, _ = run_row(input_table(row)[0])
+    assert status == 0
+    fixed = {k: v for k, v in row.items() if k not in ("vx", "vy", "w")}
+    rest = (float(y[0]), float(y[1]), float(y[2]))
+    return row, rest, RunoutVehicle("r", fixed, (row["x"], row["y"]), row["psi"], None, None, rest)
+
+
+def reaches(row: dict, state, rest) -> bool:
+    """`state` = (vx, vy, w), run forward at the default tolerance, stops within
+    1 mm and 0.01 deg of `rest`."""
+    from impactsym.runout.batch import input_table, run_row
+
+    values = dict(row, vx=state[0], vy=state[1], w=state[2])
+    y, _, status, _, _ = run_row(input_table(values)[0])
+    return status == 0 and math.hypot(y[0] - rest[0], y[1] - rest[1]) < 1e-3 and abs(y[2] - rest[2]) < 1.75e-4

@@ -14,33 +14,11 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 import pytest
 
 from impactsym.runout.batch import input_table, run_row
 from impactsym.runout.fit import DISTINCT_SPEED, DISTINCT_YAW, fit_rest
-from impactsym.runout.scene import RunoutVehicle
-from tests.runout_rows import realistic_row
-
-
-def _round_trip(index: int):
-    """(row, rest pose reached, vehicle to fit) of the seed-5 row `index`."""
-    rng = np.random.default_rng(5)
-    rows = [realistic_row(rng) for _ in range(index + 1)]
-    row = rows[index]
-    y, _, status, _, _ = run_row(input_table(row)[0])
-    assert status == 0
-    fixed = {k: v for k, v in row.items() if k not in ("vx", "vy", "w")}
-    rest = (float(y[0]), float(y[1]), float(y[2]))
-    return row, rest, RunoutVehicle("r", fixed, (row["x"], row["y"]), row["psi"], None, None, rest)
-
-
-def _reaches(row: dict, state, rest) -> bool:
-    """`state` = (vx, vy, w), run forward at the default tolerance, stops within
-    1 mm and 0.01 deg of `rest`."""
-    values = dict(row, vx=state[0], vy=state[1], w=state[2])
-    y, _, status, _, _ = run_row(input_table(values)[0])
-    return status == 0 and math.hypot(y[0] - rest[0], y[1] - rest[1]) < 1e-3 and abs(y[2] - rest[2]) < 1.75e-4
+from tests.runout_rows import reaches, round_trip
 
 
 def _states(fit):
@@ -49,18 +27,18 @@ def _states(fit):
 
 @pytest.mark.parametrize("index", [1, 16])
 def test_every_named_state_reaches_the_rest_pose_and_none_repeats(index):
-    row, rest, vehicle = _round_trip(index)
+    row, rest, vehicle = round_trip(index)
     fit = fit_rest(vehicle)
     assert fit.converged
     states = _states(fit)
-    assert all(_reaches(row, s, rest) for s in states)
+    assert all(reaches(row, s, rest) for s in states)
     for i, a in enumerate(states):
         for b in states[:i]:
             assert math.hypot(a[0] - b[0], a[1] - b[1]) > DISTINCT_SPEED or abs(a[2] - b[2]) > DISTINCT_YAW
 
 
 def test_a_second_state_reaching_the_same_rest_pose_is_named():
-    row, rest, vehicle = _round_trip(1)
+    row, rest, vehicle = round_trip(1)
     fit = fit_rest(vehicle)
     states = _states(fit)
     truth = (row["vx"], row["vy"], row["w"])
@@ -73,7 +51,7 @@ def test_a_second_state_reaching_the_same_rest_pose_is_named():
 
 def test_a_unique_slide_names_no_other_state():
     """All wheels locked, the rest pose of a slide: one state, nothing else named."""
-    _, _, vehicle = _round_trip(0)
+    _, _, vehicle = round_trip(0)
     vehicle.row.update({f"state_{k}": 1.0 for k in ("fl", "fr", "rl", "rr")})
     vehicle.row.update({f"brake_{k}": 0.0 for k in ("fl", "fr", "rl", "rr")})
     values = dict(vehicle.row, vx=9.0, vy=-4.0, w=0.8)

@@ -226,6 +226,10 @@ def test_cli_validate(capsys, tmp_path):
         "iihs_v2v.png",
         "nhtsa.png",
     }
+    # each dataset's section links its own figure (the run-out's plan view has none)
+    for title, name in (("IIHS small-overlap barrier", "iihs"), ("NHTSA car-to-SUV", "nhtsa")):
+        (line,) = [ln for ln in out.splitlines() if ln.startswith(f"![{title}")]
+        assert line.endswith(f"{name}.png)"), line
 
 
 def test_v2v_conserves_momentum_and_is_physical(datasets):

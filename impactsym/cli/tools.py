@@ -32,7 +32,7 @@ def _run_validate(args: argparse.Namespace) -> int:
     figures = None
     if args.plots:
         paths = validation.plot(datasets, args.plots)
-        figures = {ds.name: str(path) for ds, path in zip(datasets, paths)}
+        figures = {path.stem: str(path) for path in paths}  # a dataset's own figure is named after it
     print(validation.markdown(datasets, figures) if args.markdown else validation.text_summary(datasets))
     return 0
 

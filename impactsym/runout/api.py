@@ -26,21 +26,61 @@ READING = (0.1, 1.0)
 LOOSE = {"speed": 1.0, "direction": 10.0, "yaw_rate": 0.5}
 
 
-def runout(scene, path: bool = False, tol: float | None = None) -> dict:
+def runout(
+    scene,
+    path: bool = False,
+    tol: float | None = None,
+    exhaustive: bool = False,
+    speed_max: float | None = None,
+    yaw_rate_max: float | None = None,
+) -> dict:
     """The run-out of every vehicle of `scene` (path, mapping or Scene):
     ``{"vehicles": [...], "warnings": [...]}`` (conventions.md). With `path`,
-    each entry also holds ``"path": [[t, x, y, psi_deg], ...]``."""
+    each entry also holds ``"path": [[t, x, y, psi_deg], ...]``. With
+    `exhaustive`, each fitted vehicle's fit also runs the grid search over
+    separation speeds up to `speed_max` (scene units per second) and yaw rates
+    up to `yaw_rate_max` (rad/s), each by default fit.py's `plausible_range`;
+    its entry's ``fit.search`` says what was searched and what was found."""
     sc = scene if isinstance(scene, RunoutScene) else load_runout(scene)
     warnings = list(sc.warnings)
-    entries = [_vehicle(sc, v, i, path, tol, warnings) for i, v in enumerate(sc.vehicles)]
+    grid = _grid_options(sc, exhaustive, speed_max, yaw_rate_max, warnings)
+    entries = [_vehicle(sc, v, i, path, tol, warnings, grid) for i, v in enumerate(sc.vehicles)]
     return {"units": sc.units, "vehicles": entries, "warnings": warnings}
 
 
-def _vehicle(sc: RunoutScene, v: RunoutVehicle, index: int, path: bool, tol, warnings: list) -> dict:
+def _grid_options(sc: RunoutScene, exhaustive: bool, speed_max, yaw_rate_max, warnings: list) -> dict:
+    """`fit_rest`'s grid-search keywords (SI) from `runout`'s; a range given
+    without `exhaustive`, or not a positive number, is refused naming it."""
+    given = {"speed_max": speed_max, "yaw_rate_max": yaw_rate_max}
+    for name, value in given.items():
+        if value is None:
+            continue
+        if not exhaustive:
+            raise SceneError("only applies to the grid search (exhaustive)", name)
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, (int, float))
+            or not math.isfinite(value)
+            or value <= 0
+        ):
+            raise SceneError(f"must be a positive number, got {value!r}", name)
+    if exhaustive and not any(v.fitted for v in sc.vehicles):
+        warnings.append("exhaustive: no vehicle has its separation state fitted; nothing was searched")
+    length = sc.length()
+    return {
+        "exhaustive": exhaustive,
+        "speed_max": None if speed_max is None else speed_max * length,
+        "yaw_rate_max": yaw_rate_max,
+    }
+
+
+def _vehicle(
+    sc: RunoutScene, v: RunoutVehicle, index: int, path: bool, tol, warnings: list, grid: dict
+) -> dict:
     length = sc.length()
     fit = None
     if v.fitted:
-        fit = fit_rest(v, tol)
+        fit = fit_rest(v, tol, **grid)
         if not fit.converged:
             warnings.append(
                 f"vehicles[{index}] ({v.name}): the fit to rest did not converge in {fit.iterations} iterations "
@@ -96,6 +136,9 @@ def _vehicle(sc: RunoutScene, v: RunoutVehicle, index: int, path: bool, tol, war
             names = {"fl": "front_left", "fr": "front_right", "rl": "rear_left", "rr": "rear_right"}
             residual["marks"] = {names[k]: abs(math.degrees(d)) for k, d in zip(v.marks, fit.marks)}
         entry["fit"] = {"residual": residual, "iterations": fit.iterations, "converged": fit.converged}
+        if fit.grid is not None:
+            states = 1 + len(fit.alternatives) if fit.converged else 0
+            entry["fit"]["search"] = fit.grid.summary(length) | {"states": states}
         D = determination(v, fit)
         if D is not None:
             entry["fit"]["determination"] = _determination(D, vx, vy, length)

@@ -1,4 +1,4 @@
-"""`impactsym runout SCENE [--json] [--path] [--plot OUT.png]`.
+"""`impactsym runout SCENE [--json] [--path] [--plot OUT.png] [--exhaustive [--speed-max V] [--yaw-rate-max W]]`.
 
 Registered in impactsym/cli.py's COMMANDS (help, add_arguments, run). A bad
 scene raises SceneError, which the command line prints as one line (exit 2).
@@ -29,6 +29,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="solve: pre-impact -> impact -> rest (solve --json plus each rest); reconstruct: rest -> fitted "
         "separation -> pre-impact (reconstruct --json plus each run-out)",
     )
+    parser.add_argument(
+        "--exhaustive",
+        action="store_true",
+        help="also search a grid of separation states over the plausible range for every state that reaches a "
+        "fitted vehicle's rest pose (seconds per vehicle)",
+    )
+    parser.add_argument(
+        "--speed-max", type=float, metavar="V", help="the grid's largest separation speed (scene units/s)"
+    )
+    parser.add_argument(
+        "--yaw-rate-max", type=float, metavar="W", help="the grid's largest |yaw rate| (rad/s)"
+    )
 
 
 def add_parser(subparsers) -> argparse.ArgumentParser:
@@ -43,9 +55,17 @@ def run(args: argparse.Namespace) -> int:
     from .scene import load_runout
 
     if args.chain:
+        if args.exhaustive:
+            raise SceneError("the grid search runs on a plain run-out; leave out --chain", "--exhaustive")
         return _run_chain(args)
     scene = load_runout(args.scene)
-    result = runout(scene, path=bool(args.path or args.plot))
+    grid = {"speed_max": args.speed_max, "yaw_rate_max": args.yaw_rate_max}
+    try:
+        result = runout(scene, path=bool(args.path or args.plot), exhaustive=args.exhaustive, **grid)
+    except SceneError as err:  # a grid option is named as the command line spells it
+        if err.field not in grid:
+            raise
+        raise SceneError(str(err)[len(err.field) + 2 :], "--" + err.field.replace("_", "-")) from None
     if args.plot:
         from .plot import plot_runout
 
@@ -174,6 +194,8 @@ def table(result: dict) -> str:
                 f"  residual against the measured rest: {res['position']:.2g} {unit}, "
                 f"{res['heading']:.2g} deg{extra}"
             )
+        if "search" in v.get("fit", {}):
+            lines.append(_search_line(v["fit"]["search"], unit))
         if "determination" in v.get("fit", {}):
             moves = misreading(v["fit"]["determination"], result["units"])
             shown = ", ".join(
@@ -187,3 +209,14 @@ def table(result: dict) -> str:
             )
     lines += [f"warning: {w}" for w in result["warnings"]]
     return "\n".join(lines)
+
+
+def _search_line(search: dict, unit: str) -> str:
+    """The grid search of a fitted vehicle, one line."""
+    n = search["states"]
+    return (
+        f"  grid search: {search['runouts']} run-outs, speed up to {search['speed_max']:.3g} {unit}/s "
+        f"(spacing {search['spacing']['speed']:.2g}), yaw rate within +-{search['yaw_rate_max']:.3g} rad/s "
+        f"(spacing {search['spacing']['yaw_rate']:.2g}), Newton from {search['starts']} of its "
+        f"{search['minima']} local minima: {n} state{' reaches' if n == 1 else 's reach'} the rest pose"
+    )

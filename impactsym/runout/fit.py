@@ -33,7 +33,10 @@ still reaches the rest pose and is still distinct from every state found:
 every alternative in the warnings is a separation state that reaches the rest
 pose within the tolerances, and no two are the same state. The reported state
 is the one nearest the estimate; the others are its `alternatives`. The search
-is not exhaustive: a state no start leads to is not named.
+is not exhaustive: a state no start leads to is not named. With `exhaustive`,
+the fit also starts Newton from the local minima of a grid over the plausible
+range (grid.py, `plausible_range`), and names what they reach the same way;
+a fit none of whose starts converged runs that search as its last rescue.
 
 Further evidence (least squares over all rows, Levenberg-Marquardt as above):
 the direction of a wheel's tyre mark at separation (`_mark_rows`) and poses the
@@ -52,6 +55,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from . import grid as grids
 from . import threads, via
 from .batch import columns, run_row
 from .scene import RunoutVehicle, row_values
@@ -88,6 +92,14 @@ COARSE = 100.0  # Newton's first stage stops at COARSE x (POSITION_TOL, HEADING_
 # most twice as large) or within the tolerance per row: a state that reaches
 # the rest pose but misses the other evidence is no alternative.
 EVIDENCE_COST_SHARE = 4.0
+# The grid search's default range (`plausible_range`): RANGE_SHARE times the
+# starting estimate's speed and yaw rate, at least SPEED_FLOOR and YAW_FLOOR.
+# Over the benchmark's 40 random round trips (seeds 5 and 6) the generating state
+# used at most 0.65 of the speed range and 0.48 of the yaw-rate range
+# (tests/test_runout_grid.py).
+RANGE_SHARE = 2.0
+SPEED_FLOOR = 10.0  # m/s
+YAW_FLOOR = 4.0  # rad/s
 
 
 @dataclass
@@ -110,6 +122,7 @@ class Fit:
     )  # per intermediate pose: (position miss [m], heading miss [rad] or None)
     cost: float = math.inf  # squared norm of the weighted residual (rest, marks, poses)
     jacobian: np.ndarray | None = None  # of the weighted residual (rows as in _evaluate) at the state
+    grid: grids.Grid | None = None  # the grid search, when the fit ran one (exhaustive)
 
 
 def _wheel_table(row: dict):
@@ -345,7 +358,14 @@ def _diverse(starts: list, count: int) -> list:
     return taken[1:]
 
 
-def fit_rest(vehicle: RunoutVehicle, tol: float | None = None, check_unique: bool = True) -> Fit:
+def fit_rest(
+    vehicle: RunoutVehicle,
+    tol: float | None = None,
+    check_unique: bool = True,
+    exhaustive: bool = False,
+    speed_max: float | None = None,
+    yaw_rate_max: float | None = None,
+) -> Fit:
     """The separation state reaching `vehicle.rest`. Newton starts from the
     best of the scanned candidates around the documented estimate, then (until
     one converges) from the next UNIQUE_STARTS diverse ones and RESCUE_STARTS
@@ -353,13 +373,31 @@ def fit_rest(vehicle: RunoutVehicle, tol: float | None = None, check_unique: boo
     converged one run as the uniqueness check, and the other separation states
     found that reach the rest pose (polished to the full tolerances, distinct
     from each other) are attached as `alternatives` (module docstring).
+    With `exhaustive`, Newton also starts from the grid search's minima over
+    |v| <= `speed_max` [m/s], |w| <= `yaw_rate_max` [rad/s] (each defaults to
+    `plausible_range`'s), and `Fit.grid` records the search.
     With tyre-mark directions or intermediate poses, see `_fit_evidence`."""
+    span = plausible_range(vehicle, speed_max, yaw_rate_max) if exhaustive else None
     if vehicle.marks or vehicle.via:
-        return _fit_evidence(vehicle, tol, check_unique)
-    return _search(vehicle, tol, check_unique)
+        return _fit_evidence(vehicle, tol, check_unique, span)
+    return _search(vehicle, tol, check_unique, span)
 
 
-def _fit_evidence(vehicle: RunoutVehicle, tol, check_unique: bool) -> Fit:
+def plausible_range(
+    vehicle: RunoutVehicle, speed_max: float | None = None, yaw_rate_max: float | None = None
+) -> tuple[float, float]:
+    """(speed_max [m/s], yaw_rate_max [rad/s]) of the grid search: the given
+    values, else RANGE_SHARE times the starting estimate's speed and yaw rate,
+    at least SPEED_FLOOR and YAW_FLOOR."""
+    vx, vy, w = starting_estimate(vehicle)
+    if speed_max is None:
+        speed_max = max(RANGE_SHARE * math.hypot(vx, vy), SPEED_FLOOR)
+    if yaw_rate_max is None:
+        yaw_rate_max = max(RANGE_SHARE * abs(w), YAW_FLOOR)
+    return float(speed_max), float(yaw_rate_max)
+
+
+def _fit_evidence(vehicle: RunoutVehicle, tol, check_unique: bool, span=None) -> Fit:
     """Least squares over the rest pose and the further evidence, from every
     separation state that reaches the rest pose alone (the rest-only fit and
     its alternatives: each is a basin the evidence may choose; started from
@@ -377,10 +415,13 @@ def _fit_evidence(vehicle: RunoutVehicle, tol, check_unique: bool) -> Fit:
     if not any(_meets(vehicle, f) for f in found):  # no rest-pose state meets the evidence: search it all
         other = _search(vehicle, tol, check_unique)
         if not found:
+            other.grid = plain.grid
             return other
         if other.converged and all(_distinct(other, g) for g in found):
             found.append(other)
-    return _least_cost(vehicle, found, check_unique)
+    best = _least_cost(vehicle, found, check_unique)
+    best.grid = plain.grid
+    return best
 
 
 def _least_cost(vehicle: RunoutVehicle, found: list, check_unique: bool) -> Fit:
@@ -393,8 +434,10 @@ def _least_cost(vehicle: RunoutVehicle, found: list, check_unique: bool) -> Fit:
     return best
 
 
-def _search(vehicle: RunoutVehicle, tol, check_unique: bool) -> Fit:
-    """The scan, the Newton starts and the uniqueness check of `fit_rest`."""
+def _search(vehicle: RunoutVehicle, tol, check_unique: bool, span=None) -> Fit:
+    """The scan, the Newton starts and the uniqueness check of `fit_rest`;
+    with `span` = (speed_max, yaw_rate_max), the grid search's starts too,
+    which also run over the default range when no other start converged."""
     estimate = starting_estimate(vehicle)
     starts = _scan(vehicle, estimate, LOOSE_TOL) or [estimate]
     diverse = _diverse(starts, UNIQUE_STARTS)
@@ -412,14 +455,30 @@ def _search(vehicle: RunoutVehicle, tol, check_unique: bool) -> Fit:
                     if g is not None and all(_distinct(g, h) for h in found):
                         found.append(g)
             break
+    if not found and span is None:  # every start failed: the grid search is the last rescue
+        span = plausible_range(vehicle)
+    grid = None if span is None else _grid_states(vehicle, tol, span, found)
     if not found:
+        first.grid = grid
         return first
     if vehicle.marks or vehicle.via:  # least squares: the state that fits the evidence best
         return _least_cost(vehicle, found, check_unique)
     est = np.array(estimate)
     best = min(found, key=lambda f: _distance(f, est))
     best.alternatives = [f for f in found if f is not best]
+    best.grid = grid
     return best
+
+
+def _grid_states(vehicle: RunoutVehicle, tol, span, found: list) -> grids.Grid:
+    """Run the grid search over `span` and Newton (to the full tolerances) from
+    each of its starts on the room's threads; append to `found` every converged
+    state distinct from those already there. Returns the search."""
+    grid = grids.scan(vehicle, *span, _radius(vehicle.row), LOOSE_TOL)
+    for g in threads.pool().map(functools.partial(newton, vehicle, tol=tol), grid.starts):
+        if g.converged and all(_distinct(g, h) for h in found):
+            found.append(g)
+    return grid
 
 
 def _unique(vehicle: RunoutVehicle, start, *, tol, known: list) -> Fit | None:

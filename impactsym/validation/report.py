@@ -427,7 +427,8 @@ def _ricsac_runout() -> Dataset:
         f"{min(spins):.2f}-{max(spins):.2f} g for the spinning ones, which the lateral tyre forces "
         "also stop) (column 'drag needed'): the wheel states assumed (free rolling, no engine drag, "
         "no damaged or jammed wheels) are the weak input. The forward headings of the cars that "
-        "mostly translate are within the bound; the fit reaches the rest poses only by sliding "
-        "sideways, or does not converge.",
+        "mostly translate are within the bound; the fit reaches the rest poses only from separation "
+        "states far from the measured ones (sliding sideways, or spinning nearly in place), or does not "
+        "converge.",
     ]
     return ds

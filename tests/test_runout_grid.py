@@ -1,0 +1,173 @@
+"""The fit's grid search (`fit_rest(..., exhaustive=True)`, `runout --exhaustive`):
+the local minima it starts from, the default range, and what it finds.
+
+Rows come from tests/runout_rows.py (the benchmark's round trips, seed 5).
+Row 1 (steered, rolling, locked, locked): the fit alone names two states
+reaching the rest pose; the grid search finds a third, 0.6 rad/s from the
+generating one. Row 13 (every wheel rolling, a 66 m spinning run-out): the fit
+alone names one state, the grid search another (neither is the generating
+state, whose basin is narrower than the grid: docs/runout.md, "The grid search").
+Seed 6, row 13: no start of the fit converges; the grid search, its last
+rescue, finds the generating state.
+"""
+
+from __future__ import annotations
+
+import copy
+import importlib
+import json
+import math
+
+import numpy as np
+import pytest
+
+from impactsym.runout import runout
+from impactsym.runout.fit import DISTINCT_SPEED, DISTINCT_YAW, fit_rest, plausible_range
+from tests.helpers import EXAMPLES, one_line_error, run_cli
+from tests.runout_rows import reaches, round_trip
+
+grid = importlib.import_module("impactsym.runout.grid")
+
+
+def _states(fit):
+    return [(f.velocity[0], f.velocity[1], f.yaw_rate) for f in (fit, *fit.alternatives)]
+
+
+def _distinct(states) -> bool:
+    return all(
+        math.hypot(a[0] - b[0], a[1] - b[1]) > DISTINCT_SPEED or abs(a[2] - b[2]) > DISTINCT_YAW
+        for i, a in enumerate(states)
+        for b in states[:i]
+    )
+
+
+def test_local_minima_are_the_points_no_neighbour_undercuts():
+    """Two wells, a plateau of infinity (failed run-outs) and a minimum on the
+    grid's face: the wells' bottoms and the face point, nothing else."""
+    i, j, k = np.meshgrid(np.arange(9), np.arange(9), np.arange(7), indexing="ij")
+    miss = np.minimum((i - 2) ** 2 + (j - 2) ** 2 + (k - 3) ** 2, (i - 6) ** 2 + (j - 7) ** 2 + k**2 + 0.5)
+    miss = miss.astype(float)
+    miss[:, :, 6] = np.inf
+    found = {tuple(p) for p in np.argwhere(grid._local_minima(miss))}
+    assert found == {(2, 2, 3), (6, 7, 0)}
+
+
+def test_the_default_range_holds_every_generating_state_of_the_round_trips():
+    """40 round trips (seeds 5 and 6): the generating separation state lies
+    inside the grid's default range (speed and yaw rate)."""
+    for seed in (5, 6):
+        for index in range(20):
+            row, _, vehicle = round_trip(index, seed)
+            speed_max, yaw_max = plausible_range(vehicle)
+            assert math.hypot(row["vx"], row["vy"]) < speed_max and abs(row["w"]) < yaw_max, (seed, index)
+
+
+def test_the_grid_finds_a_third_state_of_row_1():
+    row, rest, vehicle = round_trip(1)
+    plain = _states(fit_rest(vehicle))
+    fit = fit_rest(vehicle, exhaustive=True)
+    states = _states(fit)
+    assert len(states) >= len(plain) + 1 >= 3
+    assert all(reaches(row, s, rest) for s in states)
+    assert _distinct(states)
+    truth = (row["vx"], row["vy"], row["w"])
+    assert any(
+        math.hypot(s[0] - truth[0], s[1] - truth[1]) < 0.01 and abs(s[2] - truth[2]) < 0.01 for s in states
+    )
+    assert fit.grid.shape == (31, 31, 33) and 0 < len(fit.grid.starts) <= min(
+        grid.MAX_STARTS, fit.grid.minima
+    )
+
+
+def test_the_grid_finds_another_state_of_row_13():
+    row, rest, vehicle = round_trip(13)
+    plain = _states(fit_rest(vehicle))
+    states = _states(fit_rest(vehicle, exhaustive=True))
+    assert len(states) > len(plain)
+    assert all(reaches(row, s, rest) for s in states) and _distinct(states)
+
+
+def test_a_fit_whose_starts_all_fail_is_rescued_by_the_grid():
+    row, rest, vehicle = round_trip(13, seed=6)
+    fit = fit_rest(vehicle)
+    assert fit.converged and fit.grid is not None
+    assert fit.velocity == pytest.approx((row["vx"], row["vy"]), abs=0.01)
+    assert fit.yaw_rate == pytest.approx(row["w"], abs=0.01)
+    assert reaches(row, _states(fit)[0], rest)
+
+
+def test_a_locked_slide_stays_unique_under_the_grid():
+    row, _, vehicle = round_trip(0)
+    vehicle.row.update({f"state_{k}": 1.0 for k in ("fl", "fr", "rl", "rr")})
+    vehicle.row.update({f"brake_{k}": 0.0 for k in ("fl", "fr", "rl", "rr")})
+    vehicle.rest = _rest(dict(vehicle.row, vx=9.0, vy=-4.0, w=0.8))
+    fit = fit_rest(vehicle, exhaustive=True, speed_max=20.0, yaw_rate_max=3.0)
+    assert fit.converged and fit.alternatives == []
+    assert (fit.grid.speed_max, fit.grid.yaw_rate_max) == (20.0, 3.0)
+    assert fit.velocity == pytest.approx((9.0, -4.0), abs=0.01) and fit.yaw_rate == pytest.approx(
+        0.8, abs=0.01
+    )
+
+
+def _rest(values: dict):
+    from impactsym.runout.batch import input_table, run_row
+
+    y, _, _, _, _ = run_row(input_table(values)[0])
+    return float(y[0]), float(y[1]), float(y[2])
+
+
+def test_the_cli_reports_the_search_in_json(capsys):
+    code, out, _ = run_cli(capsys, "runout", EXAMPLES / "runout" / "fit_tbone.json", "--exhaustive", "--json")
+    assert code == 0
+    for v in json.loads(out)["vehicles"]:
+        search = v["fit"]["search"]
+        assert search["grid"] == [31, 31, 33] and search["runouts"] == 23397
+        assert search["states"] >= 1 and 0 < search["starts"] <= min(search["minima"], grid.MAX_STARTS)
+        assert search["spacing"]["speed"] == pytest.approx(search["speed_max"] / grid.SPEED_CELLS)
+    code, out, _ = run_cli(capsys, "runout", EXAMPLES / "runout" / "fit_tbone.json", "--exhaustive")
+    assert code == 0 and out.count("grid search:") == 2
+
+
+def test_the_range_is_in_the_scene_units():
+    """US units: speed_max in ft/s, reported back as given."""
+    scene = json.loads((EXAMPLES / "runout" / "fit_tbone.json").read_text())
+    ft = 0.3048
+    us = copy.deepcopy(scene)
+    us["units"] = "US"
+    for v in us["vehicles"]:
+        v["mass"] /= 14.59390293720636
+        v["yaw_inertia"] /= 14.59390293720636 * ft**2
+        for key in ("wheelbase", "cg_to_front_axle", "track"):
+            v[key] /= ft
+        for pose in ("separation", "rest"):
+            v[pose]["position"] = [p / ft for p in v[pose]["position"]]
+    us["runout"]["gravity"] = 9.80665 / ft
+    us["vehicles"] = us["vehicles"][:1]
+    entry = runout(us, exhaustive=True, speed_max=60.0)["vehicles"][0]
+    assert entry["fit"]["search"]["speed_max"] == pytest.approx(60.0)
+    assert entry["fit"]["search"]["spacing"]["speed"] == pytest.approx(4.0)
+
+
+@pytest.mark.parametrize(
+    "argv, field",
+    [
+        (("--speed-max", "20"), "--speed-max"),
+        (("--exhaustive", "--yaw-rate-max", "-2"), "--yaw-rate-max"),
+        (("--exhaustive", "--speed-max", "nan"), "--speed-max"),
+        (("--exhaustive", "--chain", "reconstruct"), "--exhaustive"),
+    ],
+)
+def test_bad_grid_options_are_one_line_errors(capsys, argv, field):
+    err = one_line_error(capsys, "runout", EXAMPLES / "runout" / "fit_tbone.json", *argv)
+    assert f"error: {field}:" in err
+
+
+def test_a_forward_scene_says_nothing_was_searched():
+    res = runout(EXAMPLES / "runout" / "sedan.json", exhaustive=True)
+    assert any("nothing was searched" in w for w in res["warnings"])
+    assert "fit" not in res["vehicles"][0]
+
+
+def test_an_evidence_fit_carries_its_search():
+    entry = runout(EXAMPLES / "runout" / "fit_intermediate.json", exhaustive=True)["vehicles"][0]
+    assert entry["fit"]["converged"] and entry["fit"]["search"]["states"] >= 1
