@@ -100,6 +100,11 @@ EVIDENCE_COST_SHARE = 4.0
 RANGE_SHARE = 2.0
 SPEED_FLOOR = 10.0  # m/s
 YAW_FLOOR = 4.0  # rad/s
+# The rescue of a fit none of whose starts converged: the grid search at these
+# resolutions (points each side of zero: vx and vy, w), coarse first (about 0.7 s
+# a vehicle on the RICSAC run-outs against 3 s), until one converges. The coarse grid is no
+# subset of the fine one: it fitted the RICSAC Pinto, the fine one did not.
+RESCUE_CELLS = ((8, 8), (grids.SPEED_CELLS, grids.YAW_CELLS))
 
 
 @dataclass
@@ -437,7 +442,8 @@ def _least_cost(vehicle: RunoutVehicle, found: list, check_unique: bool) -> Fit:
 def _search(vehicle: RunoutVehicle, tol, check_unique: bool, span=None) -> Fit:
     """The scan, the Newton starts and the uniqueness check of `fit_rest`;
     with `span` = (speed_max, yaw_rate_max), the grid search's starts too,
-    which also run over the default range when no other start converged."""
+    which also run over the default range (at RESCUE_CELLS) when no other
+    start converged."""
     estimate = starting_estimate(vehicle)
     starts = _scan(vehicle, estimate, LOOSE_TOL) or [estimate]
     diverse = _diverse(starts, UNIQUE_STARTS)
@@ -455,9 +461,12 @@ def _search(vehicle: RunoutVehicle, tol, check_unique: bool, span=None) -> Fit:
                     if g is not None and all(_distinct(g, h) for h in found):
                         found.append(g)
             break
-    if not found and span is None:  # every start failed: the grid search is the last rescue
-        span = plausible_range(vehicle)
     grid = None if span is None else _grid_states(vehicle, tol, span, found)
+    if not found and span is None:  # every start failed: the grid search is the last rescue
+        for cells in RESCUE_CELLS:
+            grid = _grid_states(vehicle, tol, plausible_range(vehicle), found, cells)
+            if found:
+                break
     if not found:
         first.grid = grid
         return first
@@ -470,11 +479,14 @@ def _search(vehicle: RunoutVehicle, tol, check_unique: bool, span=None) -> Fit:
     return best
 
 
-def _grid_states(vehicle: RunoutVehicle, tol, span, found: list) -> grids.Grid:
-    """Run the grid search over `span` and Newton (to the full tolerances) from
-    each of its starts on the room's threads; append to `found` every converged
-    state distinct from those already there. Returns the search."""
-    grid = grids.scan(vehicle, *span, _radius(vehicle.row), LOOSE_TOL)
+def _grid_states(vehicle: RunoutVehicle, tol, span, found: list, cells=None) -> grids.Grid:
+    """Run the grid search over `span` (at `cells`, default grid.py's) and
+    Newton (to the full tolerances) from each of its starts on the room's
+    threads; append to `found` every converged state distinct from those
+    already there. Returns the search."""
+    grid = grids.scan(
+        vehicle, *span, _radius(vehicle.row), LOOSE_TOL, cells or (grids.SPEED_CELLS, grids.YAW_CELLS)
+    )
     for g in threads.pool().map(functools.partial(newton, vehicle, tol=tol), grid.starts):
         if g.converged and all(_distinct(g, h) for h in found):
             found.append(g)

@@ -49,8 +49,8 @@ class Grid:
             "yaw_rate_max": self.yaw_rate_max,
             "grid": list(self.shape),
             "spacing": {
-                "speed": self.speed_max / SPEED_CELLS / length,
-                "yaw_rate": self.yaw_rate_max / YAW_CELLS,
+                "speed": 2 * self.speed_max / (self.shape[0] - 1) / length,
+                "yaw_rate": 2 * self.yaw_rate_max / (self.shape[2] - 1),
             },
             "runouts": self.runouts,
             "minima": self.minima,
@@ -58,12 +58,20 @@ class Grid:
         }
 
 
-def scan(vehicle: RunoutVehicle, speed_max: float, yaw_rate_max: float, scale: float, tol: float) -> Grid:
-    """Run the grid of `vehicle` (module docstring) at integrator tolerance
-    `tol`; the miss of a point is |rest position miss|^2 + (heading miss x
-    `scale`)^2 (fit.py's weighting), infinite where the run-out failed."""
-    axis = np.linspace(-speed_max, speed_max, 2 * SPEED_CELLS + 1)
-    yaw = np.linspace(-yaw_rate_max, yaw_rate_max, 2 * YAW_CELLS + 1)
+def scan(
+    vehicle: RunoutVehicle,
+    speed_max: float,
+    yaw_rate_max: float,
+    scale: float,
+    tol: float,
+    cells: tuple[int, int] = (SPEED_CELLS, YAW_CELLS),
+) -> Grid:
+    """Run the grid of `vehicle` (module docstring; `cells` the points each side
+    of zero along vx and vy, and along w) at integrator tolerance `tol`; the
+    miss of a point is |rest position miss|^2 + (heading miss x `scale`)^2
+    (fit.py's weighting), infinite where the run-out failed."""
+    axis = np.linspace(-speed_max, speed_max, 2 * cells[0] + 1)
+    yaw = np.linspace(-yaw_rate_max, yaw_rate_max, 2 * cells[1] + 1)
     VX, VY, W = np.meshgrid(axis, axis, yaw, indexing="ij")
     # the disk, with room for round-off at its rim (the points on the axes)
     inside = speed_max**2 * (1 + 1e-12) >= VX**2 + VY**2
