@@ -413,6 +413,7 @@ def _ricsac_runout() -> Dataset:
     inside = [
         r["label"] for r in free if r["locked distance_ft"] <= r["runout_distance_ft"] <= r["distance_ft"]
     ]
+    stuck = [r["label"] for r in ds.tables["fit"] if not r["converged"]]
     ds.notes += [
         ASSUMPTIONS["ricsac_runout"],
         f"Bracket (every wheel locked instead of rolling, same separation state): the measured "
@@ -428,7 +429,7 @@ def _ricsac_runout() -> Dataset:
         "also stop) (column 'drag needed'): the wheel states assumed (free rolling, no engine drag, "
         "no damaged or jammed wheels) are the weak input. The forward headings of the cars that "
         "mostly translate are within the bound; the fit reaches the rest poses only from separation "
-        "states far from the measured ones (sliding sideways, or spinning nearly in place), or does not "
-        "converge.",
+        "states far from the measured ones (sliding sideways, or spinning nearly in place)"
+        + (f"; it does not converge for {', '.join(stuck)}." if stuck else "."),
     ]
     return ds
