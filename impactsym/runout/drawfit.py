@@ -20,8 +20,9 @@ forward differences of three run-outs. A row is converged within `draw_tolerance
 1 % of the draws' rest-pose spread, between fit.py's tolerances (0.1 mm,
 1e-5 rad) and 1 mm, 1e-4 rad. Rows still open after MAX_ITERATIONS go to
 fit.py's exact Newton, a row per task on the room's threads; a row that does
-not converge there is
-reported as not fitted.
+not converge there is reported as not fitted. With tyre-mark directions the
+fit is least squares over the rest pose and the marks, and every row goes to
+that exact Newton (`_exact_rows`).
 
 Measured (`python -m benchmarks uncertainty --parts runout`, docs/runout.md):
 all wheels locked, 3.9 run-outs per draw (two vehicles: the start, a Newton
@@ -35,6 +36,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -112,6 +114,7 @@ def fit_draws(
     vehicle: RunoutVehicle,
     tol: float | None = None,
     tols: tuple[float, float] = (POSITION_TOL, HEADING_TOL),
+    marks: Mapping[str, np.ndarray] | None = None,
 ) -> DrawFit:
     """Fit rows of the run-out `table` (rows, COLUMNS; its vx, vy, w ignored)
     to `target` (rows, 3: x, y [m], psi [rad]) from `start` (rows, 3) or the
@@ -120,7 +123,12 @@ def fit_draws(
     `vehicle` is the nominal RunoutVehicle (its row layout for the exact
     fallback); `tol` the integrator tolerance of the run-outs (None: the
     kernel's default), `tols` the (position [m], heading [rad]) misses within
-    which a row is fitted (`draw_tolerances`)."""
+    which a row is fitted (`draw_tolerances`). With tyre-mark directions
+    (`marks`: wheel key -> (rows,) [rad]) the fit is least squares over the rest
+    pose and the marks, which the batched steps here (a square system) do not
+    solve: every row goes to fit.py's Newton from `start` (`_exact_rows`)."""
+    if marks:
+        return _exact_rows(vehicle, table, target, start, marks, tol)
     n = table.shape[0]
     names = columns()
     a, wb, track = (table[:, names.index(c)] for c in ("a", "L", "track"))
@@ -177,9 +185,25 @@ def fit_draws(
     return DrawFit(p, out, runouts, int(exact.size))
 
 
-def _exact(vehicle: RunoutVehicle, table, target, p, tol, i: int):
-    """Row i fitted by fit.py's exact Newton from its last state (on the room's threads)."""
-    return newton(_variant(vehicle, table[i], target[i]), tuple(p[i]), tol)
+def _exact(vehicle: RunoutVehicle, table, target, p, tol, i: int, marks=None):
+    """Row i fitted by fit.py's exact Newton from its last state (on the room's
+    threads); with `marks` (wheel key -> rows [rad]), least squares over them too."""
+    drawn = {key: float(a[i]) for key, a in marks.items()} if marks else {}
+    return newton(variant(vehicle, table[i], target[i], drawn), tuple(p[i]), tol)
+
+
+def _exact_rows(vehicle: RunoutVehicle, table, target, start, marks, tol) -> DrawFit:
+    """Every row by fit.py's Newton from `start` with its drawn tyre-mark
+    directions (the fit's tolerances; `runouts` is not counted there: every
+    row is an exact one)."""
+    p = np.array(start, dtype=np.float64, copy=True)
+    refit = functools.partial(_exact, vehicle, table, target, p, tol, marks=marks)
+    status = np.full(p.shape[0], NOT_CONVERGED)
+    for i, fit in enumerate(threads.pool().map(refit, range(p.shape[0]))):
+        if fit.converged:
+            p[i], status[i] = (*fit.velocity, fit.yaw_rate), 0
+    p[status != 0] = math.nan
+    return DrawFit(p, status, 0, int(p.shape[0]))
 
 
 def _differences(table, p, r, target, weight, tol) -> np.ndarray:
@@ -228,8 +252,9 @@ def _broyden(B: np.ndarray, rows: np.ndarray, s: np.ndarray, y: np.ndarray) -> N
     B[rows[ok]] += (y - Bs)[ok, :, None] * s[ok, None, :] / ss[ok, None, None]
 
 
-def _variant(vehicle: RunoutVehicle, row: np.ndarray, target: np.ndarray) -> RunoutVehicle:
-    """The nominal vehicle with one drawn row and rest pose (fit.newton's input)."""
+def variant(vehicle: RunoutVehicle, row: np.ndarray, target: np.ndarray, marks=None) -> RunoutVehicle:
+    """The nominal vehicle with one drawn row, rest pose and tyre-mark
+    directions (wheel key -> rad; none by default) (fit.newton's input)."""
     values = dict(zip(columns(), (float(x) for x in row)))
     return dataclasses.replace(
         vehicle,
@@ -237,6 +262,6 @@ def _variant(vehicle: RunoutVehicle, row: np.ndarray, target: np.ndarray) -> Run
         position=(values["x"], values["y"]),
         heading=values["psi"],
         rest=tuple(float(x) for x in target),
-        marks={},
+        marks=dict(marks or {}),
         via=(),
     )

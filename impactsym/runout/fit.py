@@ -39,7 +39,7 @@ range (grid.py, `plausible_range`), and names what they reach the same way;
 a fit none of whose starts converged runs that search as its last rescue.
 
 Further evidence (least squares over all rows, Levenberg-Marquardt as above):
-the direction of a wheel's tyre mark at separation (`_mark_rows`) and poses the
+the direction of a wheel's tyre mark at separation (`mark_rows`) and poses the
 vehicle passed through between separation and rest (via.py: the path's point
 nearest a given position, and its heading). With such evidence the fit starts
 from every state found that reaches the rest pose alone (`_fit_evidence`); the
@@ -171,13 +171,13 @@ def _evaluate(vehicle, cols, p, tol):
     )
     if status != 0 or (points and path.shape[0] >= points):  # failed, or more steps than the path holds
         return None, None
-    scale = _radius(vehicle.row)
+    scale = heading_scale(vehicle.row)
     r = _rest_rows(vehicle, y, scale)
     S = y[7:].reshape(6, 4)
     J = S[:3, :3].copy()
     J[2] *= scale
     if vehicle.marks:
-        rm, Jm = _mark_rows(vehicle, p, scale)
+        rm, Jm = mark_rows(vehicle, p, scale)
         r, J = np.concatenate([r, rm]), np.vstack([J, Jm])
     if vehicle.via:
         rv, Jv = via.residuals(vehicle.via, path, scale, jacobian=True)
@@ -185,7 +185,7 @@ def _evaluate(vehicle, cols, p, tol):
     return r, J
 
 
-def _mark_rows(vehicle: RunoutVehicle, p, scale: float):
+def mark_rows(vehicle: RunoutVehicle, p, scale: float):
     """Residuals (wrapped angle differences times `scale`) and Jacobian rows of
     the tyre-mark directions: a mark leaves along the wheel's contact-point
     velocity u = v + w (-r_y, r_x) at separation, r the wheel's position from
@@ -206,7 +206,9 @@ def _mark_rows(vehicle: RunoutVehicle, p, scale: float):
     return np.array(res), np.array(rows)
 
 
-def _radius(row) -> float:
+def heading_scale(row) -> float:
+    """R_max [m], the heading residual's weight: the farthest wheel from the
+    centre of gravity, so that one radian of heading counts as R_max metres."""
     return math.hypot(max(row["a"], row["L"] - row["a"]), row["track"] / 2)
 
 
@@ -245,7 +247,7 @@ def _newton(vehicle: RunoutVehicle, start, tol, budget: int, coarse: float = 1.0
     bound there) and converges to the same roots elsewhere; the step is the
     undeflated one times 1/(1 - grad(log m).dp). An iterate within the
     distinctness thresholds of a known state ends the run unconverged."""
-    cols, scale = columns(), _radius(vehicle.row)
+    cols, scale = columns(), heading_scale(vehicle.row)
     p = np.array(start, dtype=float)
     r, J = _evaluate(vehicle, cols, p, tol)
     iterations, runs, lam, stalled = 0, 1, 1e-3, False
@@ -304,7 +306,7 @@ def determination(vehicle: RunoutVehicle, fit: Fit) -> np.ndarray | None:
     the fit did not converge."""
     if fit.jacobian is None or not fit.converged:
         return None
-    return np.linalg.pinv(fit.jacobian)[:, :3] * np.array([1.0, 1.0, _radius(vehicle.row)])
+    return np.linalg.pinv(fit.jacobian)[:, :3] * np.array([1.0, 1.0, heading_scale(vehicle.row)])
 
 
 def _yaw_candidates(w: float) -> list[float]:
@@ -321,14 +323,14 @@ def _scan(vehicle: RunoutVehicle, estimate, tol) -> list:
     SPEED_SCALES, each yaw rate of `_yaw_candidates`, each run forward (through
     `run_row`, the scene's one row function; with intermediate poses their
     misses count in the ranking, as the tyre-mark directions' do)."""
-    cols, scale = columns(), _radius(vehicle.row)
+    cols, scale = columns(), heading_scale(vehicle.row)
     vx, vy, w = estimate
     starts = [(vx * sv, vy * sv, yaw) for sv in SPEED_SCALES for yaw in _yaw_candidates(w)]
 
     def miss2(p) -> float:
         miss = _forward_miss(vehicle, row_values(vehicle, cols, *p), tol, scale)
         if miss is not None and vehicle.marks:
-            miss = np.concatenate([miss, _mark_rows(vehicle, p, scale)[0]])
+            miss = np.concatenate([miss, mark_rows(vehicle, p, scale)[0]])
         return math.inf if miss is None else float(miss @ miss)
 
     res = list(threads.pool().map(miss2, starts))
@@ -485,7 +487,7 @@ def _grid_states(vehicle: RunoutVehicle, tol, span, found: list, cells=None) -> 
     threads; append to `found` every converged state distinct from those
     already there. Returns the search."""
     grid = grids.scan(
-        vehicle, *span, _radius(vehicle.row), LOOSE_TOL, cells or (grids.SPEED_CELLS, grids.YAW_CELLS)
+        vehicle, *span, heading_scale(vehicle.row), LOOSE_TOL, cells or (grids.SPEED_CELLS, grids.YAW_CELLS)
     )
     for g in threads.pool().map(functools.partial(newton, vehicle, tol=tol), grid.starts):
         if g.converged and all(_distinct(g, h) for h in found):

@@ -8,9 +8,9 @@ points, the normal ...) and the run-out's leaves, read by the same
 distributions): ``runout.friction``, ``runout.slip_angle_max``,
 ``runout.rolling_resistance``, ``impact.position``, and per vehicle
 ``friction``, ``rest.position``, ``rest.heading``, ``separation.position``,
-``separation.heading`` and each wheel's ``brake`` and ``steer``. The impact
-leaves a run-out also uses (mass, yaw inertia, heading, impact point) enter
-both.
+``separation.heading``, each wheel's ``brake`` and ``steer`` and each tyre-mark
+direction (``separation.mark_directions.<wheel>``). The impact leaves a run-out
+also uses (mass, yaw inertia, heading, impact point) enter both.
 
 Monte Carlo (`impactsym.uncertainty.propagate`, the engine of every
 ``--uncertainty``): per draw each vehicle's separation state is fitted to its
@@ -33,7 +33,10 @@ sensitivities for the other run-out columns (m, I, alpha_max, f_r, brake,
 steer): those come from central differences of forward run-outs at
 `FD_TOL`, step 1 % of the input's sd. The separation states so linearised go
 through the engine's chain (the scene map, the exact reconstruct Jacobian,
-the JSON map) to ``sd_linear`` and ``budget``.
+the JSON map) to ``sd_linear`` and ``budget``. A vehicle with tyre-mark
+directions is fitted in least squares over its rest pose and marks: its
+dp/dx is -pinv(J_r) dr/dx over both (`_least_squares_slopes`), and each draw
+is fitted by fit.py's Newton (drawfit.py).
 """
 
 from __future__ import annotations
@@ -56,7 +59,8 @@ from ..uncertainty.propagation import linear_method
 from . import _door
 from .batch import columns, run_row, runout_batch
 from .chain import _check, _impact_part, reconstruct_from_rest
-from .drawfit import NOT_CONVERGED, draw_tolerances, fit_draws
+from .drawfit import NOT_CONVERGED, draw_tolerances, fit_draws, variant
+from .fit import heading_scale, mark_rows
 from .scene import SLUG, RunoutScene, load_runout, row_values
 
 FD_TOL = 1e-10  # integrator tolerance of the central differences (docs/runout.md: error ~6e-7 m)
@@ -105,6 +109,10 @@ def _nominal_leaves(data: dict, units: str) -> dict:
             if isinstance(v.get(block), dict):
                 pair(v[block], "position", f"{p}.{block}.position")
                 number(v[block], "heading", f"{p}.{block}.heading", "angle")
+        marks = v["separation"].get("mark_directions") if isinstance(v.get("separation"), dict) else None
+        if isinstance(marks, dict):
+            for name in WHEEL_KEYS:
+                number(marks, name, f"{p}.separation.mark_directions.{name}", "angle")
         if isinstance(v.get("wheels"), dict):
             for name, wheel in v["wheels"].items():
                 if isinstance(wheel, dict):
@@ -200,6 +208,17 @@ class Chained:
         )
         return table, target
 
+    def marks(self, k: int, values: Mapping, n: int) -> dict:
+        """Vehicle k's tyre-mark directions per row: wheel key -> (n,) [rad]
+        (empty without marks)."""
+        p = f"vehicles[{k}].separation.mark_directions"
+        given = self.runout.vehicles[k].marks
+        return {
+            key: np.broadcast_to(np.deg2rad(np.asarray(values[f"{p}.{name}"], dtype=np.float64)), (n,))
+            for name, key in WHEEL_KEYS.items()
+            if key in given
+        }
+
     def deviation(self, overrides: Mapping, n: int) -> np.ndarray:
         """(n, inputs): each input's draw minus its nominal value."""
         return (
@@ -230,13 +249,15 @@ class Chained:
         dx = self.deviation(overrides, n)
         for k, vehicle in enumerate(self.runout.vehicles):
             table, target = self.table(k, values, cols, n)
+            marks = self.marks(k, values, n)
             p = np.full((n, 3), math.nan)
             rows = np.flatnonzero(reason == "")
             if rows.size:
                 start = self.p[k] + dx[rows] @ self.A[k].T
                 first = self.J[k] + np.einsum("nj,jab->nab", dx[rows], self.dJ[k])
                 tols, tol = draw_tolerances(self.J[k], start - self.p[k])
-                fit = fit_draws(table[rows], target[rows], start, self.p[k], first, vehicle, tol, tols)
+                drawn = {key: a[rows] for key, a in marks.items()}
+                fit = fit_draws(table[rows], target[rows], start, self.p[k], first, vehicle, tol, tols, drawn)
                 p[rows] = fit.state
                 self.work["runouts"] += fit.runouts
                 self.work["exact_rows"] += fit.exact_rows
@@ -300,8 +321,35 @@ class Chained:
                 + np.outer(dtheta[:, names.index("psi")], spsi)
             )
             dR += self._other_sensitivities(base[0], p, dtheta, h, other)
-            self.A.append(np.linalg.solve(J, (dT - dR).T))
+            if vehicle.marks:  # least squares over the rest pose and the marks
+                self.A.append(self._least_squares_slopes(kv, J, dR - dT, table, target, values, h))
+            else:
+                self.A.append(np.linalg.solve(J, (dT - dR).T))
             self.dJ.append(self._jacobian_slopes(vehicle, base[0], p, self.A[-1], dtheta, h))
+
+    def _least_squares_slopes(self, k, J, dr, table, target, values, h) -> np.ndarray:
+        """(3, inputs): dp/dx of vehicle k's least-squares fit over its rest pose
+        and tyre marks, -pinv(Jr) dr/dx to first order (the fit's `determination`
+        rule), Jr the weighted residual's Jacobian (rest rows times (1, 1, R_max),
+        then fit.py's mark rows) and dr/dx its change with each input: `dr` (inputs,
+        3) for the rest pose, central differences of the mark rows over the
+        rows of `table` (each input moved by +-h, the marks' own directions with
+        them) for the marks."""
+        vehicle, p = self.runout.vehicles[k], self.p[k]
+        scale = heading_scale(vehicle.row)
+        weight = np.array([1.0, 1.0, scale])
+        marks = self.marks(k, values, table.shape[0])
+        rows = np.array(
+            [
+                mark_rows(
+                    variant(vehicle, table[i], target[i], {key: a[i] for key, a in marks.items()}), p, scale
+                )[0]
+                for i in range(table.shape[0])
+            ]
+        )
+        dm = (rows[0::2] - rows[1::2]) / (2 * h[:, None])
+        Jr = np.vstack([J * weight[:, None], mark_rows(vehicle, p, scale)[1]])
+        return -np.linalg.pinv(Jr) @ np.hstack([dr * weight, dm]).T
 
     def _jacobian_slopes(self, vehicle, base, p, A, dtheta, h) -> np.ndarray:
         """(inputs, 3, 3): dJ/dx_j along the linear prediction (the separation
@@ -382,11 +430,6 @@ def nominal_data(scene) -> tuple[dict, dict, dict]:
     for i, v in enumerate(data.get("vehicles") or []):
         if not isinstance(v, dict):
             continue
-        if isinstance(v.get("separation"), dict) and v["separation"].get("mark_directions"):
-            raise SceneError(
-                "not read by --uncertainty through the run-out (leave it out)",
-                f"vehicles[{i}].separation.mark_directions",
-            )
         if v.get("intermediate"):
             raise SceneError(
                 "not read by --uncertainty through the run-out (leave it out)", f"vehicles[{i}].intermediate"
