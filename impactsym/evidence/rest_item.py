@@ -46,8 +46,9 @@ from ..runout.scene import RunoutVehicle
 from ..scene.casefile import LeafReader, check_keys
 from .items import Observation, vehicle_index
 
-#: A fit vehicle's keys that only a rest item reads (the run-out's chassis and tyres).
-RUNOUT_VEHICLE_KEYS = tuple(key for key in RUNOUT_KEYS if key != "rest")
+#: A fit vehicle's keys that only a rest item reads (the run-out's chassis and
+#: tyres; the item's own pose is its value, and intermediate poses are not read).
+RUNOUT_VEHICLE_KEYS = tuple(key for key in RUNOUT_KEYS if key not in ("rest", "intermediate"))
 POSE_KEYS = ("position", "heading")
 NONLINEAR = 0.2  # sd of the separation state: a linearisation departing more is named
 LABELS = ("Vx", "Vy", "W")

@@ -20,9 +20,9 @@ forward differences of three run-outs. A row is converged within `draw_tolerance
 1 % of the draws' rest-pose spread, between fit.py's tolerances (0.1 mm,
 1e-5 rad) and 1 mm, 1e-4 rad. Rows still open after MAX_ITERATIONS go to
 fit.py's exact Newton, a row per task on the room's threads; a row that does
-not converge there is reported as not fitted. With tyre-mark directions the
-fit is least squares over the rest pose and the marks, and every row goes to
-that exact Newton (`_exact_rows`).
+not converge there is reported as not fitted. With tyre-mark directions or
+intermediate poses the fit is least squares over the rest pose and them, and
+every row goes to that exact Newton (`_exact_rows`).
 
 Measured (`python -m benchmarks uncertainty --parts runout`, docs/runout.md):
 all wheels locked, 3.9 run-outs per draw (two vehicles: the start, a Newton
@@ -36,13 +36,13 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from collections.abc import Mapping
 
 import numpy as np
 
 from . import threads
 from .batch import columns, runout_batch
 from .fit import HEADING_TOL, POSITION_TOL, newton
+from .fit import MAX_ITERATIONS as NEWTON_BUDGET
 from .scene import RunoutVehicle
 
 MAX_ITERATIONS = 20  # batched trials before a row goes to the exact Newton
@@ -51,6 +51,7 @@ STEP_SHARE, STEP_SPEED, STEP_YAW = 0.5, 2.0, 2.0  # trust region of a step (m/s,
 FAR = 0.05  # m (heading weighted by R_max): a start missing by more also tries the nominal state
 STALL = 0.25  # a trial that does not cut the squared residual by this much renews the Jacobian
 FD_SHARE = 1e-3
+RETRY_BUDGET = 160  # run-outs of a least-squares draw that did not settle in fit.py's budget
 # A draw's fit converges to DRAW_SHARE of the draws' rest-pose spread, at most
 # 1 mm and 1e-4 rad; its run-outs then run at tolerance DRAW_TOL, whose worst
 # rest-position error over the benchmark's random run-outs was 8.6e-5 m
@@ -114,7 +115,7 @@ def fit_draws(
     vehicle: RunoutVehicle,
     tol: float | None = None,
     tols: tuple[float, float] = (POSITION_TOL, HEADING_TOL),
-    marks: Mapping[str, np.ndarray] | None = None,
+    evidence=None,
 ) -> DrawFit:
     """Fit rows of the run-out `table` (rows, COLUMNS; its vx, vy, w ignored)
     to `target` (rows, 3: x, y [m], psi [rad]) from `start` (rows, 3) or the
@@ -123,12 +124,13 @@ def fit_draws(
     `vehicle` is the nominal RunoutVehicle (its row layout for the exact
     fallback); `tol` the integrator tolerance of the run-outs (None: the
     kernel's default), `tols` the (position [m], heading [rad]) misses within
-    which a row is fitted (`draw_tolerances`). With tyre-mark directions
-    (`marks`: wheel key -> (rows,) [rad]) the fit is least squares over the rest
-    pose and the marks, which the batched steps here (a square system) do not
-    solve: every row goes to fit.py's Newton from `start` (`_exact_rows`)."""
-    if marks:
-        return _exact_rows(vehicle, table, target, start, marks, tol)
+    which a row is fitted (`draw_tolerances`). With `evidence` (tyre-mark
+    directions, intermediate poses per row: uncertain.Evidence) the fit is
+    least squares over the rest pose and the evidence, which the batched steps
+    here (a square system) do not solve: every row goes to fit.py's Newton
+    from `start` (`_exact_rows`)."""
+    if evidence is not None:
+        return _exact_rows(vehicle, table, target, start, evidence, tol)
     n = table.shape[0]
     names = columns()
     a, wb, track = (table[:, names.index(c)] for c in ("a", "L", "track"))
@@ -185,21 +187,30 @@ def fit_draws(
     return DrawFit(p, out, runouts, int(exact.size))
 
 
-def _exact(vehicle: RunoutVehicle, table, target, p, tol, i: int, marks=None):
+def _exact(vehicle: RunoutVehicle, table, target, p, tol, i: int, evidence=None, budget=NEWTON_BUDGET):
     """Row i fitted by fit.py's exact Newton from its last state (on the room's
-    threads); with `marks` (wheel key -> rows [rad]), least squares over them too."""
-    drawn = {key: float(a[i]) for key, a in marks.items()} if marks else {}
-    return newton(variant(vehicle, table[i], target[i], drawn), tuple(p[i]), tol)
+    threads; `budget` run-outs, default fit.py's); with `evidence` (its marks
+    and intermediate poses per row), least squares over them too."""
+    drawn = evidence.row(i) if evidence is not None else ()
+    return newton(variant(vehicle, table[i], target[i], *drawn), tuple(p[i]), tol, budget)
 
 
-def _exact_rows(vehicle: RunoutVehicle, table, target, start, marks, tol) -> DrawFit:
+def _exact_rows(vehicle: RunoutVehicle, table, target, start, evidence, tol) -> DrawFit:
     """Every row by fit.py's Newton from `start` with its drawn tyre-mark
-    directions (the fit's tolerances; `runouts` is not counted there: every
-    row is an exact one)."""
+    directions and intermediate poses (the fit's tolerances; `runouts` is not
+    counted there: every row is an exact one). A row whose least squares has
+    not settled within fit.py's budget runs on from where it stopped with
+    RETRY_BUDGET more (in a flat valley of the least squares the Levenberg-
+    Marquardt steps keep shaving the integrator's noise off the cost: 2 of
+    1000 draws with an intermediate pose, which settled after 22 and 59)."""
     p = np.array(start, dtype=np.float64, copy=True)
-    refit = functools.partial(_exact, vehicle, table, target, p, tol, marks=marks)
+    refit = functools.partial(_exact, vehicle, table, target, p, tol, evidence=evidence)
     status = np.full(p.shape[0], NOT_CONVERGED)
     for i, fit in enumerate(threads.pool().map(refit, range(p.shape[0]))):
+        p[i], status[i] = (*fit.velocity, fit.yaw_rate), 0 if fit.converged else NOT_CONVERGED
+    again = np.flatnonzero((status != 0) & np.isfinite(p[:, 2]))
+    retry = functools.partial(_exact, vehicle, table, target, p, tol, evidence=evidence, budget=RETRY_BUDGET)
+    for i, fit in zip(again, threads.pool().map(retry, again)):
         if fit.converged:
             p[i], status[i] = (*fit.velocity, fit.yaw_rate), 0
     p[status != 0] = math.nan
@@ -252,9 +263,10 @@ def _broyden(B: np.ndarray, rows: np.ndarray, s: np.ndarray, y: np.ndarray) -> N
     B[rows[ok]] += (y - Bs)[ok, :, None] * s[ok, None, :] / ss[ok, None, None]
 
 
-def variant(vehicle: RunoutVehicle, row: np.ndarray, target: np.ndarray, marks=None) -> RunoutVehicle:
-    """The nominal vehicle with one drawn row, rest pose and tyre-mark
-    directions (wheel key -> rad; none by default) (fit.newton's input)."""
+def variant(vehicle: RunoutVehicle, row: np.ndarray, target: np.ndarray, marks=None, via=()) -> RunoutVehicle:
+    """The nominal vehicle with one drawn row, rest pose, tyre-mark directions
+    (wheel key -> rad) and intermediate poses ((x, y [m], psi [rad] or None),
+    ...), none of either by default (fit.newton's input)."""
     values = dict(zip(columns(), (float(x) for x in row)))
     return dataclasses.replace(
         vehicle,
@@ -263,5 +275,5 @@ def variant(vehicle: RunoutVehicle, row: np.ndarray, target: np.ndarray, marks=N
         heading=values["psi"],
         rest=tuple(float(x) for x in target),
         marks=dict(marks or {}),
-        via=(),
+        via=tuple(via),
     )

@@ -126,7 +126,7 @@ class Fit:
         default_factory=list
     )  # per intermediate pose: (position miss [m], heading miss [rad] or None)
     cost: float = math.inf  # squared norm of the weighted residual (rest, marks, poses)
-    jacobian: np.ndarray | None = None  # of the weighted residual (rows as in _evaluate) at the state
+    jacobian: np.ndarray | None = None  # of the weighted residual (rows as in evaluate) at the state
     grid: grids.Grid | None = None  # the grid search, when the fit ran one (exhaustive)
 
 
@@ -161,10 +161,11 @@ def starting_estimate(vehicle: RunoutVehicle) -> tuple[float, float, float]:
     return (v0 * dx / d, v0 * dy / d, w0) if d > 0 else (0.0, 0.0, w0)
 
 
-def _evaluate(vehicle, cols, p, tol):
-    """(residual vector, Jacobian) at p = (vx, vy, w); residual None if the run
-    fails. Rows: the rest pose (x, y, psi times R_max), the mark directions,
-    the intermediate poses (via.py)."""
+def evaluate(vehicle, cols, p, tol):
+    """(residual vector, Jacobian) at p = (vx, vy, w) of the fit's weighted
+    residual; residual None if the run fails. Rows: the rest pose (x, y, psi
+    times R_max), the mark directions, the intermediate poses (via.py). `cols`
+    the kernel's columns (batch.columns())."""
     points = via.PATH_ROWS if vehicle.via else 0
     y, _, status, _, path = run_row(
         row_values(vehicle, cols, *p), tol=tol, sens=True, path_points=points, path_columns=via.PATH_COLUMNS
@@ -249,7 +250,7 @@ def _newton(vehicle: RunoutVehicle, start, tol, budget: int, coarse: float = 1.0
     distinctness thresholds of a known state ends the run unconverged."""
     cols, scale = columns(), heading_scale(vehicle.row)
     p = np.array(start, dtype=float)
-    r, J = _evaluate(vehicle, cols, p, tol)
+    r, J = evaluate(vehicle, cols, p, tol)
     iterations, runs, lam, stalled = 0, 1, 1e-3, False
     while r is not None and not _done(r, scale, coarse) and runs < budget:
         if any(_near(p, k) for k in known):
@@ -261,7 +262,7 @@ def _newton(vehicle: RunoutVehicle, start, tol, budget: int, coarse: float = 1.0
         log_m, grad = _deflation(p, known)
         step /= min(max(1.0 - float(grad @ step), 0.1), 10.0)
         trial = p + step
-        rt, Jt = _evaluate(vehicle, cols, trial, tol)
+        rt, Jt = evaluate(vehicle, cols, trial, tol)
         runs += 1
         if rt is not None and 2 * _deflation(trial, known)[0] + math.log(float(rt @ rt) + 1e-300) < (
             2 * log_m + math.log(float(r @ r) + 1e-300)

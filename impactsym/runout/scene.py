@@ -60,6 +60,7 @@ RUNOUT_VEHICLE_KEYS = (
     "wheels",
     "separation",
     "rest",
+    "intermediate",
     "friction",
 )
 VEHICLE_KEYS = (
@@ -68,7 +69,6 @@ VEHICLE_KEYS = (
     "yaw_inertia",
     "heading",
     *RUNOUT_VEHICLE_KEYS,
-    "intermediate",
     "impact_point",
     *IMPACT_VEHICLE_KEYS,
 )

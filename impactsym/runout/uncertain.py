@@ -8,9 +8,10 @@ points, the normal ...) and the run-out's leaves, read by the same
 distributions): ``runout.friction``, ``runout.slip_angle_max``,
 ``runout.rolling_resistance``, ``impact.position``, and per vehicle
 ``friction``, ``rest.position``, ``rest.heading``, ``separation.position``,
-``separation.heading``, each wheel's ``brake`` and ``steer`` and each tyre-mark
-direction (``separation.mark_directions.<wheel>``). The impact leaves a run-out
-also uses (mass, yaw inertia, heading, impact point) enter both.
+``separation.heading``, each wheel's ``brake`` and ``steer``, each tyre-mark
+direction (``separation.mark_directions.<wheel>``) and each intermediate pose
+(``intermediate[j].position``, ``.heading``). The impact leaves a run-out also
+uses (mass, yaw inertia, heading, impact point) enter both.
 
 Monte Carlo (`impactsym.uncertainty.propagate`, the engine of every
 ``--uncertainty``): per draw each vehicle's separation state is fitted to its
@@ -34,9 +35,9 @@ steer): those come from central differences of forward run-outs at
 `FD_TOL`, step 1 % of the input's sd. The separation states so linearised go
 through the engine's chain (the scene map, the exact reconstruct Jacobian,
 the JSON map) to ``sd_linear`` and ``budget``. A vehicle with tyre-mark
-directions is fitted in least squares over its rest pose and marks: its
-dp/dx is -pinv(J_r) dr/dx over both (`_least_squares_slopes`), and each draw
-is fitted by fit.py's Newton (drawfit.py).
+directions or intermediate poses is fitted in least squares over its rest pose
+and them: its dp/dx is -pinv(J_r) dr/dx over all (`_least_squares_slopes`),
+and each draw is fitted by fit.py's Newton (drawfit.py).
 """
 
 from __future__ import annotations
@@ -60,7 +61,7 @@ from . import _door
 from .batch import columns, run_row, runout_batch
 from .chain import _check, _impact_part, reconstruct_from_rest
 from .drawfit import NOT_CONVERGED, draw_tolerances, fit_draws, variant
-from .fit import heading_scale, mark_rows
+from .fit import evaluate, heading_scale
 from .scene import SLUG, RunoutScene, load_runout, row_values
 
 FD_TOL = 1e-10  # integrator tolerance of the central differences (docs/runout.md: error ~6e-7 m)
@@ -68,6 +69,9 @@ FD_TOL = 1e-10  # integrator tolerance of the central differences (docs/runout.m
 # central differences of forward run-outs for a braked wheel (chain_solve's SUV; 1e-12: 0.05 %).
 SENS_TOL = 1e-12
 FD_STEP = 1e-2  # of the input's sd
+# Why a draw's fit failed (its rejection reason, after "vehicles[k] run-out: ").
+MISSED = "no separation state reaches the drawn rest pose"
+UNSETTLED = "the least squares over the drawn rest pose, marks and poses did not converge"
 RUNOUT_LEAVES = {
     "friction": ("number", "positive"),
     "slip_angle_max": ("angle", "positive"),
@@ -113,6 +117,11 @@ def _nominal_leaves(data: dict, units: str) -> dict:
         if isinstance(marks, dict):
             for name in WHEEL_KEYS:
                 number(marks, name, f"{p}.separation.mark_directions.{name}", "angle")
+        poses = v.get("intermediate")
+        for j, pose in enumerate(poses if isinstance(poses, list) else []):
+            if isinstance(pose, dict):
+                pair(pose, "position", f"{p}.intermediate[{j}].position")
+                number(pose, "heading", f"{p}.intermediate[{j}].heading", "angle")
         if isinstance(v.get("wheels"), dict):
             for name, wheel in v["wheels"].items():
                 if isinstance(wheel, dict):
@@ -128,6 +137,31 @@ def _with_final(impact: dict, finals) -> dict:
         v["final_velocity"], v["final_yaw_rate"] = [vx, vy], w
     out.pop("correlations", None)  # read below with the run-out's leaves too
     return out
+
+
+@dataclass
+class Evidence:
+    """A vehicle's tyre-mark directions (wheel key -> (rows,) [rad]) and
+    intermediate poses ([(x, y [m], psi [rad] or None), ...], each (rows,))
+    per row of a run-out table."""
+
+    marks: dict
+    via: list
+
+    def row(self, i: int) -> tuple[dict, tuple]:
+        """(marks, via) of row i, as a RunoutVehicle holds them."""
+        marks = {key: float(a[i]) for key, a in self.marks.items()}
+        via = tuple(
+            (float(x[i]), float(y[i]), None if psi is None else float(psi[i])) for x, y, psi in self.via
+        )
+        return marks, via
+
+    def rows(self, index: np.ndarray) -> Evidence:
+        """The rows `index` only."""
+        return Evidence(
+            {key: a[index] for key, a in self.marks.items()},
+            [(x[index], y[index], None if psi is None else psi[index]) for x, y, psi in self.via],
+        )
 
 
 @dataclass
@@ -208,16 +242,30 @@ class Chained:
         )
         return table, target
 
-    def marks(self, k: int, values: Mapping, n: int) -> dict:
-        """Vehicle k's tyre-mark directions per row: wheel key -> (n,) [rad]
-        (empty without marks)."""
-        p = f"vehicles[{k}].separation.mark_directions"
-        given = self.runout.vehicles[k].marks
-        return {
-            key: np.broadcast_to(np.deg2rad(np.asarray(values[f"{p}.{name}"], dtype=np.float64)), (n,))
+    def evidence(self, k: int, values: Mapping, n: int) -> Evidence | None:
+        """Vehicle k's tyre-mark directions and intermediate poses per row (SI,
+        rad), None without them."""
+        vehicle, length, p = self.runout.vehicles[k], self.length, f"vehicles[{k}]"
+        if not (vehicle.marks or vehicle.via):
+            return None
+
+        def column(path: str, scale: float) -> np.ndarray:
+            return np.broadcast_to(np.asarray(values[path], dtype=np.float64) * scale, (n,))
+
+        marks = {
+            key: column(f"{p}.separation.mark_directions.{name}", math.pi / 180)
             for name, key in WHEEL_KEYS.items()
-            if key in given
+            if key in vehicle.marks
         }
+        via = [
+            (
+                column(f"{p}.intermediate[{j}].position[0]", length),
+                column(f"{p}.intermediate[{j}].position[1]", length),
+                None if psi is None else column(f"{p}.intermediate[{j}].heading", math.pi / 180),
+            )
+            for j, (*_, psi) in enumerate(vehicle.via)
+        ]
+        return Evidence(marks, via)
 
     def deviation(self, overrides: Mapping, n: int) -> np.ndarray:
         """(n, inputs): each input's draw minus its nominal value."""
@@ -249,21 +297,21 @@ class Chained:
         dx = self.deviation(overrides, n)
         for k, vehicle in enumerate(self.runout.vehicles):
             table, target = self.table(k, values, cols, n)
-            marks = self.marks(k, values, n)
+            evidence = self.evidence(k, values, n)
             p = np.full((n, 3), math.nan)
             rows = np.flatnonzero(reason == "")
             if rows.size:
                 start = self.p[k] + dx[rows] @ self.A[k].T
                 first = self.J[k] + np.einsum("nj,jab->nab", dx[rows], self.dJ[k])
                 tols, tol = draw_tolerances(self.J[k], start - self.p[k])
-                drawn = {key: a[rows] for key, a in marks.items()}
+                drawn = evidence.rows(rows) if evidence else None
                 fit = fit_draws(table[rows], target[rows], start, self.p[k], first, vehicle, tol, tols, drawn)
                 p[rows] = fit.state
                 self.work["runouts"] += fit.runouts
                 self.work["exact_rows"] += fit.exact_rows
                 self.work["fit_rows"] += rows.size
                 for code, text in (
-                    (NOT_CONVERGED, "no separation state reaches the drawn rest pose"),
+                    (NOT_CONVERGED, MISSED if evidence is None else UNSETTLED),
                     (2, "the run-out failed"),
                 ):
                     reason[rows[fit.status == code]] = f"vehicles[{k}] run-out: {text}"
@@ -321,35 +369,36 @@ class Chained:
                 + np.outer(dtheta[:, names.index("psi")], spsi)
             )
             dR += self._other_sensitivities(base[0], p, dtheta, h, other)
-            if vehicle.marks:  # least squares over the rest pose and the marks
-                self.A.append(self._least_squares_slopes(kv, J, dR - dT, table, target, values, h))
+            if vehicle.marks or vehicle.via:  # least squares over the rest pose and the evidence
+                self.A.append(self._least_squares_slopes(kv, dR - dT, table, target, values, h))
             else:
                 self.A.append(np.linalg.solve(J, (dT - dR).T))
             self.dJ.append(self._jacobian_slopes(vehicle, base[0], p, self.A[-1], dtheta, h))
 
-    def _least_squares_slopes(self, k, J, dr, table, target, values, h) -> np.ndarray:
-        """(3, inputs): dp/dx of vehicle k's least-squares fit over its rest pose
-        and tyre marks, -pinv(Jr) dr/dx to first order (the fit's `determination`
-        rule), Jr the weighted residual's Jacobian (rest rows times (1, 1, R_max),
-        then fit.py's mark rows) and dr/dx its change with each input: `dr` (inputs,
-        3) for the rest pose, central differences of the mark rows over the
-        rows of `table` (each input moved by +-h, the marks' own directions with
-        them) for the marks."""
-        vehicle, p = self.runout.vehicles[k], self.p[k]
-        scale = heading_scale(vehicle.row)
-        weight = np.array([1.0, 1.0, scale])
-        marks = self.marks(k, values, table.shape[0])
-        rows = np.array(
-            [
-                mark_rows(
-                    variant(vehicle, table[i], target[i], {key: a[i] for key, a in marks.items()}), p, scale
-                )[0]
-                for i in range(table.shape[0])
-            ]
-        )
-        dm = (rows[0::2] - rows[1::2]) / (2 * h[:, None])
-        Jr = np.vstack([J * weight[:, None], mark_rows(vehicle, p, scale)[1]])
-        return -np.linalg.pinv(Jr) @ np.hstack([dr * weight, dm]).T
+    def _least_squares_slopes(self, k, dr, table, target, values, h) -> np.ndarray:
+        """(3, inputs): dp/dx of vehicle k's least-squares fit over its rest pose,
+        tyre marks and intermediate poses, -pinv(Jr) dr/dx to first order (the
+        fit's `determination` rule), Jr the Jacobian of fit.py's weighted
+        residual at the nominal state (`evaluate`, tolerance SENS_TOL) and dr/dx
+        its change with each input: `dr` (inputs, 3) for the rest pose, central
+        differences of the evidence rows over the rows of `table` (each input
+        moved by +-h, the evidence's own values with it; run-outs at FD_TOL) for
+        the rest."""
+        vehicle, p, names = self.runout.vehicles[k], self.p[k], columns()
+        weight = np.array([1.0, 1.0, heading_scale(vehicle.row)])
+        _, Jr = evaluate(vehicle, names, p, SENS_TOL)
+        evidence = self.evidence(k, values, table.shape[0])
+        rows = []
+        for i in range(table.shape[0]):
+            r, _ = evaluate(variant(vehicle, table[i], target[i], *evidence.row(i)), names, p, FD_TOL)
+            if r is None:
+                raise SceneError(
+                    "a run-out near the nominal fitted state failed (linear method)", f"vehicles[{k}]"
+                )
+            rows.append(r[3:])
+        rows = np.array(rows)
+        de = (rows[0::2] - rows[1::2]) / (2 * h[:, None])
+        return -np.linalg.pinv(Jr) @ np.hstack([dr * weight, de]).T
 
     def _jacobian_slopes(self, vehicle, base, p, A, dtheta, h) -> np.ndarray:
         """(inputs, 3, 3): dJ/dx_j along the linear prediction (the separation
@@ -427,13 +476,6 @@ def nominal_data(scene) -> tuple[dict, dict, dict]:
     if not isinstance(data, dict) or data.get("units") not in ("SI", "US"):
         load_runout(data)  # names what is wrong
     leaves = _nominal_leaves(data, data["units"])
-    for i, v in enumerate(data.get("vehicles") or []):
-        if not isinstance(v, dict):
-            continue
-        if v.get("intermediate"):
-            raise SceneError(
-                "not read by --uncertainty through the run-out (leave it out)", f"vehicles[{i}].intermediate"
-            )
     if len(_check(data)) != len(data["vehicles"]):
         reconstruct_from_rest(data)  # names the vehicle without run-out data
     impact = _impact_part(data)
