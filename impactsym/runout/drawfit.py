@@ -42,7 +42,6 @@ import numpy as np
 from . import threads
 from .batch import columns, runout_batch
 from .fit import HEADING_TOL, POSITION_TOL, newton
-from .fit import MAX_ITERATIONS as NEWTON_BUDGET
 from .scene import RunoutVehicle
 
 MAX_ITERATIONS = 20  # batched trials before a row goes to the exact Newton
@@ -51,7 +50,6 @@ STEP_SHARE, STEP_SPEED, STEP_YAW = 0.5, 2.0, 2.0  # trust region of a step (m/s,
 FAR = 0.05  # m (heading weighted by R_max): a start missing by more also tries the nominal state
 STALL = 0.25  # a trial that does not cut the squared residual by this much renews the Jacobian
 FD_SHARE = 1e-3
-RETRY_BUDGET = 160  # run-outs of a least-squares draw that did not settle in fit.py's budget
 # A draw's fit converges to DRAW_SHARE of the draws' rest-pose spread, at most
 # 1 mm and 1e-4 rad; its run-outs then run at tolerance DRAW_TOL, whose worst
 # rest-position error over the benchmark's random run-outs was 8.6e-5 m
@@ -187,32 +185,23 @@ def fit_draws(
     return DrawFit(p, out, runouts, int(exact.size))
 
 
-def _exact(vehicle: RunoutVehicle, table, target, p, tol, i: int, evidence=None, budget=NEWTON_BUDGET):
+def _exact(vehicle: RunoutVehicle, table, target, p, tol, i: int, evidence=None):
     """Row i fitted by fit.py's exact Newton from its last state (on the room's
-    threads; `budget` run-outs, default fit.py's); with `evidence` (its marks
-    and intermediate poses per row), least squares over them too."""
+    threads); with `evidence` (its marks and intermediate poses per row), least
+    squares over them too."""
     drawn = evidence.row(i) if evidence is not None else ()
-    return newton(variant(vehicle, table[i], target[i], *drawn), tuple(p[i]), tol, budget)
+    return newton(variant(vehicle, table[i], target[i], *drawn), tuple(p[i]), tol)
 
 
 def _exact_rows(vehicle: RunoutVehicle, table, target, start, evidence, tol) -> DrawFit:
     """Every row by fit.py's Newton from `start` with its drawn tyre-mark
     directions and intermediate poses (the fit's tolerances; `runouts` is not
-    counted there: every row is an exact one). A row whose least squares has
-    not settled within fit.py's budget runs on from where it stopped with
-    RETRY_BUDGET more (in a flat valley of the least squares the Levenberg-
-    Marquardt steps keep shaving the integrator's noise off the cost: 2 of
-    1000 draws with an intermediate pose, which settled after 22 and 59)."""
+    counted there: every row is an exact one)."""
     p = np.array(start, dtype=np.float64, copy=True)
     refit = functools.partial(_exact, vehicle, table, target, p, tol, evidence=evidence)
     status = np.full(p.shape[0], NOT_CONVERGED)
     for i, fit in enumerate(threads.pool().map(refit, range(p.shape[0]))):
         p[i], status[i] = (*fit.velocity, fit.yaw_rate), 0 if fit.converged else NOT_CONVERGED
-    again = np.flatnonzero((status != 0) & np.isfinite(p[:, 2]))
-    retry = functools.partial(_exact, vehicle, table, target, p, tol, evidence=evidence, budget=RETRY_BUDGET)
-    for i, fit in zip(again, threads.pool().map(retry, again)):
-        if fit.converged:
-            p[i], status[i] = (*fit.velocity, fit.yaw_rate), 0
     p[status != 0] = math.nan
     return DrawFit(p, status, 0, int(p.shape[0]))
 
