@@ -398,3 +398,16 @@ def test_an_intermediate_pose_enters_the_draws_fits_and_the_linear_method(capsys
     file.write_text(json.dumps(scene))
     code, out, _ = run_cli(capsys, "reconstruct", file, "--uncertainty", "--draws", 200, "--json")
     assert code == 0 and "vehicles[0].intermediate[0].heading" in json.loads(out)["uncertainty"]["inputs"]
+
+
+def test_the_quick_linear_interval_refuses_evidence_it_does_not_linearise():
+    """runout.interval.reconstruct_interval inverts the rest pose's Jacobian
+    alone: a tyre mark is refused naming it (reconstruct --uncertainty reads it)."""
+    from impactsym.errors import SceneError
+    from impactsym.runout.interval import reconstruct_interval
+
+    scene, direction = _with_mark(3.0)
+    scene["vehicles"][0]["separation"]["mark_directions"]["front_left"] = direction
+    plain = _nominal(scene)
+    with pytest.raises(SceneError, match=r"vehicles\[0\]\.separation\.mark_directions"):
+        reconstruct_interval(plain, 0.1, 1.0, 0.05, draws=100)

@@ -10,7 +10,9 @@ Draws of the rest poses (independent normal, per vehicle) and of mu (one
 normal draw shared by both vehicles: the same road) give draws of the
 separation states, which `reconstruct_batch` turns into pre-impact speeds.
 Which input drives a speed: the share of its variance when only that input
-group varies (rest of vehicle 1, rest of vehicle 2, friction).
+group varies (rest of vehicle 1, rest of vehicle 2, friction). A scene with
+tyre-mark directions or intermediate poses is refused (their least squares is
+`reconstruct --uncertainty`'s, uncertain.py).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import math
 
 import numpy as np
 
+from ..errors import SceneError
 from ..reconstruct import reconstruct_batch
 from ..scene import load_scene, scene_columns, scene_data
 from .batch import columns, run_row
@@ -57,6 +60,15 @@ def reconstruct_interval(
         v.get("separation", {}).pop("velocity", None)
         v.get("separation", {}).pop("yaw_rate", None)
     rs = load_runout(ro)
+    for i, v in enumerate(
+        rs.vehicles
+    ):  # J^-1 is the rest pose's alone: a least squares is not linearised here
+        for given, key in ((v.marks, "separation.mark_directions"), (v.via, "intermediate")):
+            if given:
+                raise SceneError(
+                    "not read by the linear interval (reconstruct --uncertainty reads it)",
+                    f"vehicles[{i}].{key}",
+                )
     length = rs.length()
     fits = [fit_rest(v) for v in rs.vehicles]
     sens = [separation_sensitivity(v, f) for v, f in zip(rs.vehicles, fits)]

@@ -304,7 +304,7 @@ class Chained:
                 start = self.p[k] + dx[rows] @ self.A[k].T
                 first = self.J[k] + np.einsum("nj,jab->nab", dx[rows], self.dJ[k])
                 tols, tol = draw_tolerances(self.J[k], start - self.p[k])
-                drawn = evidence.rows(rows) if evidence else None
+                drawn = evidence.rows(rows) if evidence is not None else None
                 fit = fit_draws(table[rows], target[rows], start, self.p[k], first, vehicle, tol, tols, drawn)
                 p[rows] = fit.state
                 self.work["runouts"] += fit.runouts
