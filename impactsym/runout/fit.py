@@ -137,7 +137,7 @@ class Fit:
     )  # per intermediate pose: (position miss [m], heading miss [rad] or None)
     cost: float = math.inf  # squared norm of the weighted residual (rest, marks, poses)
     jacobian: np.ndarray | None = None  # of the weighted residual (rows as in evaluate) at the state
-    grid: grids.Grid | None = None  # the grid search, when the fit ran one (exhaustive)
+    grid: grids.Grid | None = None  # the grid search, when the fit ran one (exhaustive, or the rescue)
 
 
 def _wheel_table(row: dict):
@@ -262,6 +262,7 @@ def _newton(vehicle: RunoutVehicle, start, tol, budget: int, coarse: float = 1.0
     p = np.array(start, dtype=float)
     r, J = evaluate(vehicle, cols, p, tol)
     iterations, runs, lam, stalled = 0, 1, 1e-3, False
+    settle = SETTLE if coarse == 1.0 else SETTLE_COARSE
     while r is not None and not _done(r, scale, coarse) and runs < budget:
         if any(_near(p, k) for k in known):
             return Fit(
@@ -277,7 +278,6 @@ def _newton(vehicle: RunoutVehicle, start, tol, budget: int, coarse: float = 1.0
         if rt is not None and 2 * _deflation(trial, known)[0] + math.log(float(rt @ rt) + 1e-300) < (
             2 * log_m + math.log(float(r @ r) + 1e-300)
         ):
-            settle = SETTLE if coarse == 1.0 else SETTLE_COARSE
             settled = float(r @ r) - float(rt @ rt) < settle * float(r @ r) + 1e-24
             p, r, J = trial, rt, Jt
             lam = max(lam / 10, 1e-9)
@@ -493,14 +493,14 @@ def _search(vehicle: RunoutVehicle, tol, check_unique: bool, span=None) -> Fit:
     return best
 
 
-def _grid_states(vehicle: RunoutVehicle, tol, span, found: list, cells=None) -> grids.Grid:
-    """Run the grid search over `span` (at `cells`, default grid.py's) and
+def _grid_states(
+    vehicle: RunoutVehicle, tol, span, found: list, cells=(grids.SPEED_CELLS, grids.YAW_CELLS)
+) -> grids.Grid:
+    """Run the grid search over `span` (at `cells`) and
     Newton (to the full tolerances) from each of its starts on the room's
     threads; append to `found` every converged state distinct from those
     already there. Returns the search."""
-    grid = grids.scan(
-        vehicle, *span, heading_scale(vehicle.row), LOOSE_TOL, cells or (grids.SPEED_CELLS, grids.YAW_CELLS)
-    )
+    grid = grids.scan(vehicle, *span, heading_scale(vehicle.row), LOOSE_TOL, cells)
     for g in threads.pool().map(functools.partial(newton, vehicle, tol=tol), grid.starts):
         if g.converged and all(_distinct(g, h) for h in found):
             found.append(g)
