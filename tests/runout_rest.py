@@ -34,3 +34,16 @@ def rest_scene(wheels=None, sd_position=0.02, sd_heading=0.5, sd_friction=0.01) 
         }
     scene["runout"]["friction"] = {"normal": [0.75, sd_friction]}
     return scene
+
+
+def nominal_scene(scene: dict) -> dict:
+    """A copy of `scene` with every distribution replaced by its mean (all are normal here)."""
+
+    def walk(x):
+        if isinstance(x, dict):
+            return x["normal"][0] if set(x) == {"normal"} else {k: walk(v) for k, v in x.items()}
+        if isinstance(x, list):
+            return [walk(v) for v in x]
+        return x
+
+    return walk(scene)

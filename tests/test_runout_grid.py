@@ -154,7 +154,8 @@ def test_the_range_is_in_the_scene_units():
         (("--speed-max", "20"), "--speed-max"),
         (("--exhaustive", "--yaw-rate-max", "-2"), "--yaw-rate-max"),
         (("--exhaustive", "--speed-max", "nan"), "--speed-max"),
-        (("--exhaustive", "--chain", "reconstruct"), "--exhaustive"),
+        (("--exhaustive", "--chain", "solve"), "--exhaustive"),
+        (("--chain", "solve", "--yaw-rate-max", "0"), "--yaw-rate-max"),
     ],
 )
 def test_bad_grid_options_are_one_line_errors(capsys, argv, field):
@@ -171,3 +172,46 @@ def test_a_forward_scene_says_nothing_was_searched():
 def test_an_evidence_fit_carries_its_search():
     entry = runout(EXAMPLES / "runout" / "fit_intermediate.json", exhaustive=True)["vehicles"][0]
     assert entry["fit"]["converged"] and entry["fit"]["search"]["states"] >= 1
+
+
+def test_the_chained_reconstruct_gives_each_other_separation_state_its_speeds():
+    """tests/runout_rest.py's scene (pre-impact 17 and 8 m/s, run forward to
+    rest) with the sedan on a steered, a locked, a braked and a counter-steered
+    wheel: its rest pose is reached from several separation states. Each other
+    state is reconstructed too (its speeds those of a direct reconstruct with
+    it), and with the grid search one of them gives back the generating speeds."""
+    from impactsym.reconstruct import reconstruct
+    from impactsym.runout.chain import _impact_part, reconstruct_from_rest
+    from tests.runout_rest import nominal_scene, rest_scene
+
+    wheels = {
+        "front_left": {"state": "rolling", "steer": -15},
+        "front_right": "locked",
+        "rear_left": {"brake": 0.5},
+        "rear_right": {"state": "rolling", "steer": 15},
+    }
+    scene = nominal_scene(rest_scene(wheels=wheels))
+    out = reconstruct_from_rest(scene, exhaustive=True)
+    others = out["alternatives"]
+    listed = [
+        (k, a) for k, v in enumerate(out["vehicles"]) for a in v["runout"]["fit"].get("alternatives", [])
+    ]
+    assert [(o["vehicle"], o["separation"]["velocity"]) for o in others] == [
+        (k, a["velocity"]) for k, a in listed
+    ]
+    assert sum("the other separation state reaching its rest pose" in w for w in out["warnings"]) == len(
+        others
+    )
+    impact = _impact_part(scene)
+    for v, entry in zip(impact["vehicles"], out["vehicles"]):
+        v["final_velocity"], v["final_yaw_rate"] = (
+            entry["runout"]["separation"]["velocity"],
+            entry["runout"]["separation"]["yaw_rate"],
+        )
+    for o in others:
+        direct = json.loads(json.dumps(impact))
+        direct["vehicles"][o["vehicle"]].update(
+            final_velocity=o["separation"]["velocity"], final_yaw_rate=o["separation"]["yaw_rate"]
+        )
+        assert o["speed"] == pytest.approx([v.speed for v in reconstruct(direct).vehicles], rel=1e-12)
+    assert any(o["speed"] == pytest.approx([17.0, 8.0], abs=1e-3) for o in others)

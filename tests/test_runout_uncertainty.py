@@ -16,7 +16,7 @@ from impactsym.runout.batch import columns, runout_batch
 from impactsym.runout.chain import reconstruct_from_rest
 from impactsym.runout.uncertain import chained_uncertainty, load_chained, reconstruct_uncertainty
 from tests.helpers import EXAMPLES, one_line_error, run_cli
-from tests.runout_rest import rest_scene
+from tests.runout_rest import nominal_scene, rest_scene
 
 
 @pytest.fixture(scope="module")
@@ -55,7 +55,7 @@ def test_the_nominal_values_are_the_plain_reconstruct(locked):
     separation states to the bit, the numbers the output map recomputes
     (delta-V magnitudes by a hypot of its own, as for plain scenes) to rounding."""
     scene, (chained, u) = locked
-    plain = reconstruct_from_rest(_nominal(scene))
+    plain = reconstruct_from_rest(nominal_scene(scene))
     assert chained.result == plain
     for k, v in enumerate(plain["vehicles"]):
         assert u.outputs[f"vehicles[{k}].speed"]["nominal"] == v["speed"]
@@ -67,19 +67,6 @@ def test_the_nominal_values_are_the_plain_reconstruct(locked):
         plain["energy_loss"]["total"], rel=1e-14
     )
     assert u.outputs["restitution"]["nominal"] == plain["restitution"]
-
-
-def _nominal(scene: dict) -> dict:
-    """The scene with every distribution replaced by its mean (all are normal here)."""
-
-    def walk(x):
-        if isinstance(x, dict):
-            return x["normal"][0] if set(x) == {"normal"} else {k: walk(v) for k, v in x.items()}
-        if isinstance(x, list):
-            return [walk(v) for v in x]
-        return x
-
-    return walk(copy.deepcopy(scene))
 
 
 def _misses(chained, step: float) -> tuple[list[str], np.ndarray, np.ndarray]:
@@ -407,6 +394,6 @@ def test_the_quick_linear_interval_refuses_evidence_it_does_not_linearise():
 
     scene, direction = _with_mark(3.0)
     scene["vehicles"][0]["separation"]["mark_directions"]["front_left"] = direction
-    plain = _nominal(scene)
+    plain = nominal_scene(scene)
     with pytest.raises(SceneError, match=r"vehicles\[0\]\.separation\.mark_directions"):
         reconstruct_interval(plain, 0.1, 1.0, 0.05, draws=100)

@@ -136,6 +136,15 @@ def _vehicle(
             names = {"fl": "front_left", "fr": "front_right", "rl": "rear_left", "rr": "rear_right"}
             residual["marks"] = {names[k]: abs(math.degrees(d)) for k, d in zip(v.marks, fit.marks)}
         entry["fit"] = {"residual": residual, "iterations": fit.iterations, "converged": fit.converged}
+        if fit.alternatives:
+            entry["fit"]["alternatives"] = [
+                {
+                    "velocity": [alt.velocity[0] / length, alt.velocity[1] / length],
+                    "speed": math.hypot(*alt.velocity) / length,
+                    "yaw_rate": alt.yaw_rate,
+                }
+                for alt in fit.alternatives
+            ]
         if fit.grid is not None:
             states = 1 + len(fit.alternatives) if fit.converged else 0
             entry["fit"]["search"] = fit.grid.summary(length) | {"states": states}

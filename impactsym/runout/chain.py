@@ -82,9 +82,14 @@ def solve_to_rest(scene, path: bool = False) -> dict:
     return out
 
 
-def reconstruct_from_rest(scene, path: bool = False) -> dict:
+def reconstruct_from_rest(scene, path: bool = False, **search) -> dict:
     """``reconstruct --json`` of the scene with each vehicle's final motion
-    fitted to its ``rest`` pose; each entry gains ``runout`` (fit included)."""
+    fitted to its ``rest`` pose; each entry gains ``runout`` (fit included).
+    `search`: `runout`'s grid-search keywords (exhaustive, speed_max,
+    yaw_rate_max). Where another separation state reaches a vehicle's rest
+    pose (its ``runout.fit.alternatives``), the impact is also reconstructed
+    with it (the other vehicles as reported): ``"alternatives"`` lists each
+    such state with the pre-impact speeds it gives, and a warning says so."""
     data = scene_data(scene)
     chosen = _check(data)
     if len(chosen) != len(data["vehicles"]):
@@ -101,7 +106,7 @@ def reconstruct_from_rest(scene, path: bool = False) -> dict:
         sep = v.get("separation", {})
         sep.pop("velocity", None)
         sep.pop("yaw_rate", None)
-    runs = runout(ro, path=path)
+    runs = runout(ro, path=path, **search)
     impact = _impact_part(data)
     for v, entry in zip(impact["vehicles"], runs["vehicles"]):
         v["final_velocity"] = entry["separation"]["velocity"]
@@ -110,4 +115,34 @@ def reconstruct_from_rest(scene, path: bool = False) -> dict:
     for i, entry in enumerate(runs["vehicles"]):
         out["vehicles"][i]["runout"] = entry
     out["warnings"] = list(out.get("warnings", [])) + runs["warnings"]
+    others = _alternatives(impact, runs["vehicles"], out)
+    if others:
+        out["alternatives"] = others
     return out
+
+
+def _alternatives(impact: dict, entries: list, out: dict) -> list[dict]:
+    """Each other separation state that reaches a vehicle's rest pose, with the
+    pre-impact speeds the impact then gives (scene units; or why it cannot be
+    reconstructed); a warning per state in ``out``."""
+    found = []
+    for i, entry in enumerate(entries):
+        for alt in entry.get("fit", {}).get("alternatives", []):
+            scene = copy.deepcopy(impact)
+            scene["vehicles"][i]["final_velocity"] = alt["velocity"]
+            scene["vehicles"][i]["final_yaw_rate"] = alt["yaw_rate"]
+            item = {"vehicle": i, "separation": {"velocity": alt["velocity"], "yaw_rate": alt["yaw_rate"]}}
+            try:
+                item["speed"] = [v.speed for v in reconstruct(scene).vehicles]
+                then = "pre-impact speeds " + ", ".join(f"{s:.3f}" for s in item["speed"])
+            except SceneError as exc:
+                item["error"] = str(exc)
+                then = f"no reconstruction ({exc})"
+            found.append(item)
+            reported = ", ".join(f"{v['speed']:.3f}" for v in out["vehicles"])
+            out["warnings"].append(
+                f"vehicles[{i}]: the other separation state reaching its rest pose (velocity "
+                f"[{alt['velocity'][0]:.3f}, {alt['velocity'][1]:.3f}], yaw rate {alt['yaw_rate']:.3f} rad/s) "
+                f"gives {then} (reported: {reported})"
+            )
+    return found

@@ -55,17 +55,17 @@ def run(args: argparse.Namespace) -> int:
     from .scene import load_runout
 
     if args.chain:
-        if args.exhaustive:
-            raise SceneError("the grid search runs on a plain run-out; leave out --chain", "--exhaustive")
+        given = {
+            "--exhaustive": args.exhaustive,
+            "--speed-max": args.speed_max,
+            "--yaw-rate-max": args.yaw_rate_max,
+        }
+        for flag, value in given.items() if args.chain == "solve" else ():
+            if value is not None and value is not False:
+                raise SceneError("the grid search fits separation states: --chain reconstruct", flag)
         return _run_chain(args)
     scene = load_runout(args.scene)
-    grid = {"speed_max": args.speed_max, "yaw_rate_max": args.yaw_rate_max}
-    try:
-        result = runout(scene, path=bool(args.path or args.plot), exhaustive=args.exhaustive, **grid)
-    except SceneError as err:  # a grid option is named as the command line spells it
-        if err.field not in grid:
-            raise
-        raise SceneError(str(err)[len(err.field) + 2 :], "--" + err.field.replace("_", "-")) from None
+    result = _with_grid_flags(args, lambda **grid: runout(scene, path=bool(args.path or args.plot), **grid))
     if args.plot:
         from .plot import plot_runout
 
@@ -78,6 +78,18 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(table(result))
     return 0
+
+
+def _with_grid_flags(args: argparse.Namespace, call):
+    """`call` with the grid-search keywords of `args`; a bad one is named as the
+    command line spells it (--speed-max, not speed_max)."""
+    grid = {"speed_max": args.speed_max, "yaw_rate_max": args.yaw_rate_max}
+    try:
+        return call(exhaustive=args.exhaustive, **grid)
+    except SceneError as err:
+        if err.field not in grid:
+            raise
+        raise SceneError(str(err)[len(err.field) + 2 :], "--" + err.field.replace("_", "-")) from None
 
 
 def chained(args: argparse.Namespace) -> bool:
@@ -141,8 +153,13 @@ def _run_chain(args: argparse.Namespace) -> int:
 
     if args.plot:
         raise SceneError("--plot draws a plain run-out; leave out --chain to draw it", "--plot")
-    chain = solve_to_rest if args.chain == "solve" else reconstruct_from_rest
-    result = without_json_residue(chain(args.scene, path=args.path))
+    if args.chain == "solve":
+        result = solve_to_rest(args.scene, path=args.path)
+    else:
+        result = _with_grid_flags(
+            args, lambda **grid: reconstruct_from_rest(args.scene, path=args.path, **grid)
+        )
+    result = without_json_residue(result)
     print(json.dumps(json_clean(result)) if args.json else _chain_table(result))
     return 0
 
@@ -164,6 +181,8 @@ def _chain_table(result: dict) -> str:
             f"yaw rate {sep['yaw_rate']:.4f} rad/s",
             f"  rest [{rest['position'][0]:.3f}, {rest['position'][1]:.3f}], heading {rest['heading']:.2f} deg",
         ]
+        if "search" in ro.get("fit", {}):
+            lines.append(_search_line(ro["fit"]["search"], "ft" if result["units"] == "US" else "m"))
     lines += [f"warning: {w}" for w in result.get("warnings", [])]
     return "\n".join(lines)
 
