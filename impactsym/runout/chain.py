@@ -141,7 +141,7 @@ def _alternatives(impact: dict, entries: list, out: dict) -> list[dict]:
             found.append(item)
             reported = ", ".join(f"{v['speed']:.3f}" for v in out["vehicles"])
             out["warnings"].append(
-                f"vehicles[{i}]: the other separation state reaching its rest pose (velocity "
+                f"vehicles[{i}]: another separation state reaching its rest pose (velocity "
                 f"[{alt['velocity'][0]:.3f}, {alt['velocity'][1]:.3f}], yaw rate {alt['yaw_rate']:.3f} rad/s) "
                 f"gives {then} (reported: {reported})"
             )
