@@ -199,7 +199,7 @@ def test_the_chained_reconstruct_gives_each_other_separation_state_its_speeds():
     assert [(o["vehicle"], o["separation"]["velocity"]) for o in others] == [
         (k, a["velocity"]) for k, a in listed
     ]
-    assert sum("the other separation state reaching its rest pose" in w for w in out["warnings"]) == len(
+    assert sum("another separation state reaching its rest pose" in w for w in out["warnings"]) == len(
         others
     )
     impact = _impact_part(scene)
