@@ -199,9 +199,7 @@ def test_the_chained_reconstruct_gives_each_other_separation_state_its_speeds():
     assert [(o["vehicle"], o["separation"]["velocity"]) for o in others] == [
         (k, a["velocity"]) for k, a in listed
     ]
-    assert sum("another separation state reaching its rest pose" in w for w in out["warnings"]) == len(
-        others
-    )
+    assert sum("another separation state reaching its rest pose" in w for w in out["warnings"]) == len(others)
     impact = _impact_part(scene)
     for v, entry in zip(impact["vehicles"], out["vehicles"]):
         v["final_velocity"], v["final_yaw_rate"] = (
