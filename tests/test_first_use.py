@@ -472,7 +472,10 @@ def test_an_interrupted_sweep_leaves_no_spill_file_and_no_traceback(tmp_path, si
         deadline = time.monotonic() + 60
         while not any(temp.iterdir()) and time.monotonic() < deadline and process.poll() is None:
             time.sleep(0.05)
-        assert any(temp.iterdir()), "the sweep never spilled"
+        if not any(temp.iterdir()):  # say why: the sweep ended first (and how), or the minute passed
+            ended = process.poll()
+            err = process.communicate(timeout=60)[1].decode()[-3000:] if ended is not None else ""
+            raise AssertionError(f"the sweep never spilled (exit {ended}): {err}")
         time.sleep(0.5)
         process.send_signal(getattr(signal, signal_name))
         out, err = process.communicate(timeout=60)
