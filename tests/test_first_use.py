@@ -452,6 +452,10 @@ def test_an_interrupted_sweep_leaves_no_spill_file_and_no_traceback(tmp_path, si
     temp.mkdir()
     # 4e6 rows in chunks of 500: far more work than the half second before the signal,
     # even with every driver cached (1e6 rows could finish first on a warm machine).
+    # Output to files, not pipes (a full pipe would stop the sweep); faulthandler on, so
+    # that a sweep that has not spilled after two minutes can be asked where it is (CI
+    # twice saw one still running after the minute this test used to wait).
+    logs = {name: (tmp_path / f"{name}.txt").open("w+b") for name in ("out", "err")}
     process = subprocess.Popen(
         _cli(
             "sweep",
@@ -464,27 +468,38 @@ def test_an_interrupted_sweep_leaves_no_spill_file_and_no_traceback(tmp_path, si
             "500",
             "--no-progress",
         ),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        env=_env(TMPDIR=str(temp)),
+        stdout=logs["out"],
+        stderr=logs["err"],
+        env=_env(TMPDIR=str(temp), PYTHONFAULTHANDLER="1"),
     )
     try:
-        deadline = time.monotonic() + 60
+        deadline = time.monotonic() + 120
         while not any(temp.iterdir()) and time.monotonic() < deadline and process.poll() is None:
             time.sleep(0.05)
-        if not any(temp.iterdir()):  # say why: the sweep ended first (and how), or the minute passed
-            ended = process.poll()
-            err = process.communicate(timeout=60)[1].decode()[-3000:] if ended is not None else ""
-            raise AssertionError(f"the sweep never spilled (exit {ended}): {err}")
+        if not any(temp.iterdir()):  # say why: how the sweep ended, or where it was
+            if process.poll() is None:
+                process.send_signal(signal.SIGABRT)  # faulthandler prints every thread's stack
+                process.wait(timeout=60)
+            raise AssertionError(f"the sweep never spilled (exit {process.returncode}): {_tail(logs['err'])}")
         time.sleep(0.5)
         process.send_signal(getattr(signal, signal_name))
-        out, err = process.communicate(timeout=60)
+        process.wait(timeout=60)
     finally:
         process.kill()
+    err = _tail(logs["err"])
+    for log in logs.values():
+        log.close()
     # stderr in the message: where a lost signal landed is printed there ("Exception ignored ...").
-    assert process.returncode == code, err.decode()[-3000:]
-    assert err.decode() == f"impactsym: {said}\n"
+    assert process.returncode == code, err
+    assert err == f"impactsym: {said}\n"
     assert list(temp.iterdir()) == []
+
+
+def _tail(log) -> str:
+    """The last 3000 characters written to the open file `log`."""
+    log.flush()
+    log.seek(0)
+    return log.read().decode()[-3000:]
 
 
 def test_a_signal_inside_llvmlites_object_cache_hook_is_sent_again_not_lost():
