@@ -60,9 +60,8 @@ def reconstruct_interval(
         v.get("separation", {}).pop("velocity", None)
         v.get("separation", {}).pop("yaw_rate", None)
     rs = load_runout(ro)
-    for i, v in enumerate(
-        rs.vehicles
-    ):  # J^-1 is the rest pose's alone: a least squares is not linearised here
+    # J^-1 is the rest pose's alone: a least squares over marks or poses is not linearised here
+    for i, v in enumerate(rs.vehicles):
         for given, key in ((v.marks, "separation.mark_directions"), (v.via, "intermediate")):
             if given:
                 raise SceneError(
