@@ -3,7 +3,10 @@
 ``reconstruct --uncertainty`` through the run-out (uncertain.py).
 
 Quasi-Newton across the rows, vectorised with NumPy, every run-out through
-`runout_batch` (forward only: no batch driver integrates the sensitivities).
+`runout_batch` (forward only: no batch driver integrates the sensitivities),
+in waves (`_waves`): the first FIRST_WAVE rows as below, every later row from
+its nearest fitted row, moved by that row's Jacobian (the caller gives where
+the draws lie: Neighbours).
 Each row starts from its linear prediction (the nominal fit plus the linear
 method's dp/dx times the draw's deviation) or, where that misses the rest
 pose by more than FAR, the nominal fitted state if it misses by less, with
@@ -24,11 +27,12 @@ not converge there is reported as not fitted. With tyre-mark directions or
 intermediate poses the fit is least squares over the rest pose and them, and
 every row goes to that exact Newton (`_exact_rows`).
 
-Measured (`python -m benchmarks uncertainty --parts runout`, docs/runout.md):
-all wheels locked, 3.9 run-outs per draw (two vehicles: the start, a Newton
-step, a second for some rows); the mixed-wheel example
-(examples/runout/chain_reconstruct_uncertain.json), whose sedan spins, about 24,
-and 1-2 % of its rows go to the exact Newton.
+Measured (`python -m benchmarks uncertainty --parts runout`, 10^5 draws,
+docs/runout.md): all wheels locked, 3.13 run-outs per draw (two vehicles: the
+start and a Newton step for most rows); the mixed-wheel example
+(examples/runout/chain_reconstruct_uncertain.json), whose sedan spins, 4.86
+(24.5 from the linear prediction alone), and 7 of its 200,000 fits go to the
+exact Newton.
 """
 
 from __future__ import annotations
@@ -45,6 +49,7 @@ from .fit import HEADING_TOL, POSITION_TOL, newton
 from .scene import RunoutVehicle
 
 MAX_ITERATIONS = 20  # batched trials before a row goes to the exact Newton
+FIRST_WAVE = 128  # rows fitted from the linear prediction before neighbours start the rest (_waves)
 GROWTH = 100.0  # a trial missing by more than this times the current miss is not taken
 STEP_SHARE, STEP_SPEED, STEP_YAW = 0.5, 2.0, 2.0  # trust region of a step (m/s, rad/s)
 FAR = 0.05  # m (heading weighted by R_max): a start missing by more also tries the nominal state
@@ -61,6 +66,18 @@ DRAW_TOL = 1e-7
 #: Why a row was not fitted (the fitted state is NaN there).
 NOT_CONVERGED = 1
 RUN_FAILED = 2
+
+
+@dataclasses.dataclass
+class Neighbours:
+    """Where the draws lie, for starting each from a fitted neighbour
+    (`_waves`): `position` (rows, d), scaled so that the distance between two
+    draws predicts how far apart their fitted states are; `shift` (rows, 3),
+    how far each draw's inputs move the rest-pose residual at a fixed
+    separation state, to first order (x, y [m], psi [rad])."""
+
+    position: np.ndarray
+    shift: np.ndarray
 
 
 @dataclasses.dataclass
@@ -114,6 +131,7 @@ def fit_draws(
     tol: float | None = None,
     tols: tuple[float, float] = (POSITION_TOL, HEADING_TOL),
     evidence=None,
+    near: Neighbours | None = None,
 ) -> DrawFit:
     """Fit rows of the run-out `table` (rows, COLUMNS; its vx, vy, w ignored)
     to `target` (rows, 3: x, y [m], psi [rad]) from `start` (rows, 3) or the
@@ -122,13 +140,61 @@ def fit_draws(
     `vehicle` is the nominal RunoutVehicle (its row layout for the exact
     fallback); `tol` the integrator tolerance of the run-outs (None: the
     kernel's default), `tols` the (position [m], heading [rad]) misses within
-    which a row is fitted (`draw_tolerances`). With `evidence` (tyre-mark
-    directions, intermediate poses per row: uncertain.Evidence) the fit is
-    least squares over the rest pose and the evidence, which the batched steps
-    here (a square system) do not solve: every row goes to fit.py's Newton
-    from `start` (`_exact_rows`)."""
+    which a row is fitted (`draw_tolerances`). With `near` (where the draws
+    lie: Neighbours) the rows are fitted in waves (`_waves`). With `evidence`
+    (tyre-mark directions, intermediate poses per row: uncertain.Evidence) the
+    fit is least squares over the rest pose and the evidence, which the batched
+    steps here (a square system) do not solve: every row goes to fit.py's
+    Newton from `start` (`_exact_rows`)."""
     if evidence is not None:
         return _exact_rows(vehicle, table, target, start, evidence, tol)
+    jacobian = np.broadcast_to(jacobian, (table.shape[0], 3, 3))
+    if near is None or table.shape[0] < 2 * FIRST_WAVE:
+        return _batched(table, target, start, nominal, jacobian, vehicle, tol, tols)[0]
+    return _waves(table, target, start, nominal, jacobian, vehicle, tol, tols, near)
+
+
+def _waves(table, target, start, nominal, jacobian, vehicle, tol, tols, near: Neighbours) -> DrawFit:
+    """The rows in waves, each as large as all before it: the first FIRST_WAVE
+    from `start` and `jacobian` (the draws come in random order, so those are a
+    sample of all), every later row from its nearest fitted row j in
+    `near.position` (scipy's cKDTree), moved by that row's last Jacobian B_j:
+    p_j + B_j^-1 (shift_i - shift_j), the Newton step from p_j to first order in
+    the draws' difference, with B_j as its first Jacobian. Where the fitted
+    state is a strongly curved function of the draw, the neighbour's state and
+    Jacobian are far better than the nominal ones (docs/runout.md: the
+    mixed-wheel example's spinning sedan). A wave whose earlier rows all failed
+    starts from `start` instead."""
+    from scipy.spatial import cKDTree
+
+    n = table.shape[0]
+    p, status = np.full((n, 3), math.nan), np.zeros(n, dtype=np.int64)
+    B = np.array(jacobian, dtype=np.float64, copy=True)
+    runouts = exact = 0
+    lo, hi = 0, FIRST_WAVE
+    while lo < n:
+        rows = np.arange(lo, hi)
+        fitted = np.flatnonzero(status[:lo] == 0)
+        if fitted.size:
+            j = fitted[cKDTree(near.position[fitted]).query(near.position[rows])[1]]
+            moved = p[j] + _capped(_newton_step(B[j], near.shift[j] - near.shift[rows]), p[j])
+            fit, B[rows] = _batched(
+                table[rows], target[rows], moved, nominal, B[j], vehicle, tol, tols, False
+            )
+        else:
+            fit, B[rows] = _batched(
+                table[rows], target[rows], start[rows], nominal, B[rows], vehicle, tol, tols
+            )
+        p[rows], status[rows] = fit.state, fit.status
+        runouts, exact = runouts + fit.runouts, exact + fit.exact_rows
+        lo, hi = hi, min(n, 2 * hi)
+    return DrawFit(p, status, runouts, exact)
+
+
+def _batched(table, target, start, nominal, jacobian, vehicle, tol, tols, try_nominal: bool = True):
+    """The batched quasi-Newton of the module docstring over every row: the
+    DrawFit and the rows' last Jacobians (rows, 3, 3; unweighted). Without
+    `try_nominal` no row tries the nominal state (the starts are fitted neighbours)."""
     n = table.shape[0]
     names = columns()
     a, wb, track = (table[:, names.index(c)] for c in ("a", "L", "track"))
@@ -141,8 +207,8 @@ def fit_draws(
     # Where the linear prediction misses by more than FAR, the nominal state is
     # tried too and the better start kept (where the run-out is strongly
     # curved the prediction can land further off than the point it was taken at).
-    far = np.flatnonzero((status != 0) | (np.einsum("ni,ni->n", r, r) > FAR**2))
-    if far.size:
+    far = np.flatnonzero((status != 0) | (np.einsum("ni,ni->n", r, r) > FAR**2)) if try_nominal else ()
+    if len(far):
         other = np.broadcast_to(nominal, (far.size, 3))
         ro, so = _residual(table[far], other, target[far], tol)
         ro *= weight[far]
@@ -151,7 +217,7 @@ def fit_draws(
             (status[far] != 0) | (np.einsum("ni,ni->n", ro, ro) < np.einsum("ni,ni->n", r[far], r[far]))
         )
         p[far[better]], r[far[better]], status[far[better]] = other[better], ro[better], 0
-    B = np.broadcast_to(jacobian, (n, 3, 3)) * weight[:, :, None]
+    B = jacobian * weight[:, :, None]
     failed = status != 0
     open_ = ~failed & ~_done(r / weight, tols)
     for _ in range(MAX_ITERATIONS):
@@ -182,7 +248,7 @@ def fit_draws(
             open_[i] = False
     out = np.where(failed, RUN_FAILED, np.where(open_, NOT_CONVERGED, 0))
     p[out != 0] = math.nan
-    return DrawFit(p, out, runouts, int(exact.size))
+    return DrawFit(p, out, runouts, int(exact.size)), B / weight[:, :, None]
 
 
 def _exact(vehicle: RunoutVehicle, table, target, p, tol, i: int, evidence=None):

@@ -16,9 +16,10 @@ uses (mass, yaw inertia, heading, impact point) enter both.
 Monte Carlo (`impactsym.uncertainty.propagate`, the engine of every
 ``--uncertainty``): per draw each vehicle's separation state is fitted to its
 drawn rest pose under its drawn run-out (drawfit.py: batched over the draws,
-started from the nominal fit plus the linear prediction below, with the
-nominal J plus its first-order change dJ/dx dx, central differences of the
-integrated sensitivities along each input's prediction), then the impact is
+the first started from the nominal fit plus the linear prediction below, with
+the nominal J plus its first-order change dJ/dx dx, central differences of the
+integrated sensitivities along each input's prediction, the rest from their
+nearest fitted draw: `reach`, drawfit.Neighbours), then the impact is
 reconstructed from the fitted states. A draw whose fit fails is
 rejected and counted by reason.
 
@@ -60,7 +61,7 @@ from ..uncertainty.propagation import linear_method
 from . import _door
 from .batch import columns, run_row, runout_batch
 from .chain import _check, _impact_part, reconstruct_from_rest
-from .drawfit import NOT_CONVERGED, draw_tolerances, fit_draws, variant
+from .drawfit import NOT_CONVERGED, Neighbours, draw_tolerances, fit_draws, variant
 from .fit import evaluate, heading_scale
 from .scene import SLUG, RunoutScene, load_runout, row_values
 
@@ -305,7 +306,10 @@ class Chained:
                 first = self.J[k] + np.einsum("nj,jab->nab", dx[rows], self.dJ[k])
                 tols, tol = draw_tolerances(self.J[k], start - self.p[k])
                 drawn = evidence.rows(rows) if evidence is not None else None
-                fit = fit_draws(table[rows], target[rows], start, self.p[k], first, vehicle, tol, tols, drawn)
+                near = Neighbours(dx[rows] * self.reach(k, vehicle), dx[rows] @ (self.J[k] @ self.A[k]).T)
+                fit = fit_draws(
+                    table[rows], target[rows], start, self.p[k], first, vehicle, tol, tols, drawn, near
+                )
                 p[rows] = fit.state
                 self.work["runouts"] += fit.runouts
                 self.work["exact_rows"] += fit.exact_rows
@@ -317,6 +321,14 @@ class Chained:
                     reason[rows[fit.status == code]] = f"vehicles[{k}] run-out: {text}"
             self.set_final(cols, k, p)
         return cols, reason
+
+    def reach(self, k: int, vehicle) -> np.ndarray:
+        """(inputs,): how far vehicle k's fitted state moves per unit of each
+        input to first order, |diag(1, 1, R_max) dp/dx_j| (m/s per input unit):
+        the scale of drawfit's neighbour search, where a draw's deviations
+        times it place the draws whose fitted states are alike near each other."""
+        scale = np.array([1.0, 1.0, heading_scale(vehicle.row)])
+        return np.linalg.norm(self.A[k] * scale[:, None], axis=0)
 
     def linear_columns(self, overrides: Mapping):
         """Reconstruct columns with the separation states linear in the inputs."""
