@@ -87,6 +87,7 @@ def test_exact_rest_poses_give_back_the_true_speeds(seed):
     assert not any("did not converge" in w for w in out["warnings"])
 
 
+@pytest.mark.slow
 def test_rest_intervals_cover_the_truth_at_the_nominal_rate():
     """Noisy rest poses and speed (200 seeded trials over three scenes, locked
     wheels: run-outs close to linear over the rest poses' sds): each

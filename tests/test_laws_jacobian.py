@@ -183,6 +183,7 @@ def test_linear_sd_and_budget_agree_with_monte_carlo(model, law, friction):
         assert abs(sum(u.budget[path].values()) - 1) < 1e-12
 
 
+@pytest.mark.slow
 def test_the_branch_taken_proof_catches_a_wrong_derivative():
     """derive/jacobian.py's proof of a switching kernel (on the branch each point
     takes) fails when one derivative formula of a phase is off."""

@@ -11,6 +11,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 import tomllib
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -100,6 +101,7 @@ def _modules(requirements) -> set[str]:
     return names
 
 
+@pytest.mark.slow
 def test_the_first_command_installs_what_the_examples_use(tmp_path):
     extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]
     installed = _extras(FIRST)

@@ -3,6 +3,8 @@
 import json
 from pathlib import Path
 
+import pytest
+
 import impactsym
 from impactsym import load_scene
 
@@ -51,6 +53,7 @@ def test_save_plot_of_an_axes_says_what_to_do():
     assert "Axes" in text and "savefig" in text and "scene=" not in text
 
 
+@pytest.mark.slow
 def test_validate_prints_every_model_name_whole(capsys):
     from impactsym import validation
     from impactsym.cli import main

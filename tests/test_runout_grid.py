@@ -79,6 +79,7 @@ def test_the_grid_finds_a_third_state_of_row_1():
     )
 
 
+@pytest.mark.slow
 def test_the_grid_finds_another_state_of_row_13():
     row, rest, vehicle = round_trip(13)
     plain = _states(fit_rest(vehicle))
@@ -87,6 +88,7 @@ def test_the_grid_finds_another_state_of_row_13():
     assert all(reaches(row, s, rest) for s in states) and _distinct(states)
 
 
+@pytest.mark.slow
 def test_a_fit_whose_starts_all_fail_is_rescued_by_the_grid():
     row, rest, vehicle = round_trip(13, seed=6)
     fit = fit_rest(vehicle)
@@ -116,6 +118,7 @@ def _rest(values: dict):
     return float(y[0]), float(y[1]), float(y[2])
 
 
+@pytest.mark.slow
 def test_the_cli_reports_the_search_in_json(capsys):
     code, out, _ = run_cli(capsys, "runout", EXAMPLES / "runout" / "fit_tbone.json", "--exhaustive", "--json")
     assert code == 0

@@ -88,6 +88,7 @@ def _random_rows(seed: int, n: int) -> list[dict]:
     return rows
 
 
+@pytest.mark.slow
 def test_random_runouts_agree_with_the_fixed_point_reference():
     pytest.importorskip("scipy")
     from impactsym.testing.runout_reference import reference_runout

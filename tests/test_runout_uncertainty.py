@@ -399,6 +399,7 @@ def test_a_tyre_mark_enters_the_draws_fits_and_the_linear_method():
     assert np.allclose(plain.p[0], chained.p[0], rtol=0, atol=1e-6)
 
 
+@pytest.mark.slow
 def test_an_intermediate_pose_enters_the_draws_fits_and_the_linear_method(capsys, tmp_path):
     """Vehicle 0's pose halfway along its nominal path, read within 5 cm and 1 deg,
     on the all-locked scene: every draw fitted in least squares over its drawn
