@@ -58,3 +58,18 @@ def test_uncertainty_options_without_uncertainty_are_named(option, capsys):
 def test_no_warning_without_those_options(capsys):
     assert main(["reconstruct", str(UNCERTAIN)]) == 0
     assert "ignored" not in capsys.readouterr().err
+
+
+def test_the_linearity_note_needs_a_ratio_past_its_factor_and_enough_draws():
+    from impactsym.uncertainty.propagation import LINEAR_FACTOR, linearity_notes
+
+    def outputs(ratio):
+        return {"a": {"sd": 1.0, "sd_linear": 1.0}, "b": {"sd": ratio, "sd_linear": 1.0}}
+
+    assert linearity_notes(outputs(0.99 * LINEAR_FACTOR), 1000, 1000) == []
+    assert linearity_notes(outputs(1.0 / (0.99 * LINEAR_FACTOR)), 1000, 1000) == []
+    for ratio in (1.01 * LINEAR_FACTOR, 1.0 / (1.01 * LINEAR_FACTOR)):
+        (note,) = linearity_notes(outputs(ratio), 1000, 2000)
+        assert "1 of 2 outputs" in note and "(most: b," in note and "50% of the draws rejected" in note
+    assert linearity_notes(outputs(3.0), MIN_INTERVAL_DRAWS - 1, 1000) == []
+    assert linearity_notes({"c": {"sd": 1.0, "sd_linear": float("nan")}}, 1000, 1000) == []

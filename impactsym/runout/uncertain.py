@@ -57,7 +57,7 @@ from ..scene.casefile import LeafReader, domain_reasons, parse_correlations, veh
 from ..uncertainty import Source, propagate
 from ..uncertainty.commands import RECONSTRUCT, Command
 from ..uncertainty.inputs import Input
-from ..uncertainty.propagation import linear_method
+from ..uncertainty.propagation import linear_method, linearity_notes
 from . import _door
 from .batch import columns, run_row, runout_batch
 from .chain import _check, _impact_part, reconstruct_from_rest
@@ -551,6 +551,7 @@ def chained_uncertainty(scene, draws: int = 10_000, seed: int | None = None, sob
     first_order = linear_method(linear)
     for path, stats in u.outputs.items():
         stats["sd_linear"], u.budget[path] = first_order.get(path, (math.nan, {}))
+    u.notes += linearity_notes(u.outputs, u.accepted, u.n_draws)
     return chained, u
 
 

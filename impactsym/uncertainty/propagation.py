@@ -76,6 +76,11 @@ __all__ = [
 
 #: Threads drawing the blocks of a chunk.
 DRAW_THREADS = min(4, os.cpu_count() or 1)
+# Monte Carlo sd and sd_linear further apart than this (either way) get a note
+# (linearity_notes): well past the Monte Carlo sd's own error (under 8 % with
+# MIN_INTERVAL_DRAWS accepted draws) and the roughness expected of a first-order
+# method that still ranks the inputs.
+LINEAR_FACTOR = 1.5
 
 #: Flags that make a draw physically impossible (ill-conditioned headings only warn).
 REJECTING_FLAGS = (
@@ -166,7 +171,7 @@ def propagate(
         outputs,
         budget,
         kept,
-        _notes(nominal["flags"], accepted, draws, rejected),
+        _notes(nominal["flags"], accepted, draws, rejected) + linearity_notes(outputs, accepted, draws),
         seed=int(entropy) if seed is None else seed,
     )
     if sobol:
@@ -322,6 +327,33 @@ def _notes(flags: int, accepted: int, draws: int, rejected: dict) -> list[str]:
             f"{MIN_INTERVAL_DRAWS}; take more draws"
         )
     return notes
+
+
+def linearity_notes(outputs: dict, accepted: int, draws: int) -> list[str]:
+    """A note when the Monte Carlo sd and sd_linear of some outputs differ by
+    more than LINEAR_FACTOR either way (and there are MIN_INTERVAL_DRAWS
+    accepted draws, the sd's own error then under 8 %): the linear method's sd
+    and its budget shares, which are linear, do not describe those outputs."""
+    if accepted < MIN_INTERVAL_DRAWS:
+        return []
+    off = {}
+    for path, o in outputs.items():
+        sd, linear = o["sd"], o["sd_linear"]
+        if math.isfinite(sd) and math.isfinite(linear) and sd > 0.0 and linear > 0.0:
+            ratio = max(sd / linear, linear / sd)
+            if ratio > LINEAR_FACTOR:
+                off[path] = ratio
+    if not off:
+        return []
+    worst = max(off, key=off.get)
+    rejected = f", or {1.0 - accepted / draws:.0%} of the draws rejected" if accepted < draws else ""
+    return [
+        f"the linear method does not hold for {len(off)} of {len(outputs)} outputs: their Monte Carlo sd "
+        f"and sd_linear differ by more than {LINEAR_FACTOR:g} times (most: {worst}, sd "
+        f"{outputs[worst]['sd']:.4g} against sd_linear {outputs[worst]['sd_linear']:.4g}; a model curved "
+        f"over the inputs' range{rejected}); their budget shares, first-order too, do not say which input "
+        "drives them; the Monte Carlo intervals are the answer"
+    ]
 
 
 # --------------------------------------------------------------------------- linear method
