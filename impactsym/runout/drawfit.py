@@ -43,6 +43,7 @@ import math
 
 import numpy as np
 
+from .._util import require
 from . import threads
 from .batch import columns, runout_batch
 from .fit import HEADING_TOL, POSITION_TOL, newton
@@ -165,8 +166,7 @@ def _waves(table, target, start, nominal, jacobian, vehicle, tol, tols, near: Ne
     Jacobian are far better than the nominal ones (docs/runout.md: the
     mixed-wheel example's spinning sedan). A wave whose earlier rows all failed
     starts from `start` instead."""
-    from scipy.spatial import cKDTree
-
+    tree = require("scipy.spatial", extra="uncertainty", what="the draws' neighbour search").cKDTree
     n = table.shape[0]
     p, status = np.full((n, 3), math.nan), np.zeros(n, dtype=np.int64)
     B = np.array(jacobian, dtype=np.float64, copy=True)
@@ -176,7 +176,7 @@ def _waves(table, target, start, nominal, jacobian, vehicle, tol, tols, near: Ne
         rows = np.arange(lo, hi)
         fitted = np.flatnonzero(status[:lo] == 0)
         if fitted.size:
-            j = fitted[cKDTree(near.position[fitted]).query(near.position[rows])[1]]
+            j = fitted[tree(near.position[fitted]).query(near.position[rows])[1]]
             moved = p[j] + _capped(_newton_step(B[j], near.shift[j] - near.shift[rows]), p[j])
             fit, B[rows] = _batched(
                 table[rows], target[rows], moved, nominal, B[j], vehicle, tol, tols, False
