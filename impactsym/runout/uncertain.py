@@ -551,6 +551,7 @@ def chained_uncertainty(scene, draws: int = 10_000, seed: int | None = None, sob
     first_order = linear_method(linear)
     for path, stats in u.outputs.items():
         stats["sd_linear"], u.budget[path] = first_order.get(path, (math.nan, {}))
+    # propagate's own sd_linear is NaN here (the exact Source has no Jacobian kernel): noted once, now
     u.notes += linearity_notes(u.outputs, u.accepted, u.n_draws)
     return chained, u
 
