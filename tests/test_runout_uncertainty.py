@@ -372,6 +372,66 @@ def test_a_linear_method_that_does_not_hold_is_noted():
     assert "vehicles[0].runout.separation.yaw_rate" in off
 
 
+def _with_state(probabilities) -> dict:
+    """The mixed example with the sedan's rear-left wheel locked or rolling by `probabilities`."""
+    scene = json.loads((EXAMPLES / "runout" / "chain_reconstruct_uncertain.json").read_text())
+    scene["vehicles"][0]["wheels"]["rear_left"] = {"state": probabilities}
+    return scene
+
+
+def test_a_wheel_locked_with_a_probability_is_drawn_locked_or_rolling():
+    """A wheel state given as probabilities is a drawn input (1 locked, 0
+    rolling): every kept draw's fitted separation state, run forward under its
+    own drawn wheel state, reaches its drawn rest pose (within 2 mm and 2e-4
+    rad: the draws' tolerances 1 mm and 1e-4); under the other state the
+    locked draws miss it; the linear method leaves the choice out and says so;
+    the nominal scene takes the more probable state (rolling at 0.3)."""
+    path = "vehicles[0].wheels.rear_left.state"
+    chained, u = chained_uncertainty(_with_state({"locked": 0.3}), draws=1000, seed=1)
+    assert path in u.inputs
+    assert chained.result == load_chained(_with_state("rolling")).result
+    assert any(path in n and "more probable state" in n for n in u.notes)
+    assert all(u.budget[out].get(path, 0.0) == 0.0 for out in u.budget)
+    kept = u.draws
+    drawn = kept[path].to_numpy()
+    assert set(np.unique(drawn)) == {0.0, 1.0} and 0.15 < drawn.mean() < 0.45
+    cols, values, reason, n = chained.split({x: kept[x].to_numpy() for x in u.inputs})
+    assert np.all(reason == "")
+    misses = {}
+    for state in ("drawn", "flipped"):
+        if state == "flipped":
+            values = dict(values, **{path: 1.0 - drawn})
+        table, target = chained.table(0, values, cols, n)
+        run = {c: table[:, i] for i, c in enumerate(columns())}
+        sep = "vehicles[0].runout.separation"
+        run["vx"], run["vy"] = kept[f"{sep}.velocity[0]"].to_numpy(), kept[f"{sep}.velocity[1]"].to_numpy()
+        run["w"] = kept[f"{sep}.yaw_rate"].to_numpy()
+        out = runout_batch(run, tol=1e-9)
+        misses[state] = (
+            np.hypot(out["x_rest"] - target[:, 0], out["y_rest"] - target[:, 1]),
+            np.abs(out["psi_rest"] - target[:, 2]),
+        )
+    assert np.all(misses["drawn"][0] < 2e-3) and np.all(misses["drawn"][1] < 2e-4)
+    assert np.all((misses["flipped"][0] > 0.01) | (misses["flipped"][1] > 0.01))
+
+
+@pytest.mark.parametrize(
+    "probabilities, words",
+    [
+        ({"locked": 0.5}, "equal probabilities"),
+        ({"locked": 0.3, "rolling": 0.6}, "sum to 1"),
+        ({"lockd": 0.3}, 'did you mean "locked"'),
+        ({"locked": 1.3}, "between 0 and 1"),
+        ({}, "the probability of"),
+    ],
+)
+def test_a_bad_wheel_state_probability_is_one_line(tmp_path, capsys, probabilities, words):
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(_with_state(probabilities)))
+    err = one_line_error(capsys, "reconstruct", path, "--uncertainty", "--draws", 200)
+    assert "vehicles[0].wheels.rear_left.state" in err and words in err
+
+
 def _sd_within(u, share: float) -> None:
     """Every output that is not constant: Monte Carlo sd within `share` of
     sd_linear; at least 30 such outputs."""

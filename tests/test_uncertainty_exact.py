@@ -17,7 +17,7 @@ import pytest
 from impactsym.batch import selection as _selection
 from impactsym.batch.plans import BLOCK, SamplePlan
 from impactsym.batch.quantiles import percentiles
-from impactsym.uncertainty.inputs import Input
+from impactsym.uncertainty.inputs import CHOICE, Input
 
 Q = (5.0, 50.0, 95.0)
 
@@ -83,3 +83,17 @@ def test_streamed_stats_give_numpy_percentiles(name, parts):
             stats.add(p)
     got, want = stats.percentiles(Q), np.percentile(np.concatenate(parts), Q)
     assert np.array_equal(got, want, equal_nan=True), (name, got, want)
+
+
+def test_a_choice_is_one_with_its_probability_and_monotone_in_the_score():
+    x = Input("vehicles[0].wheels.rear_left.state", CHOICE, (0.3,))
+    u = (np.arange(100_000) + 0.5) / 100_000
+    drawn = x.from_unit(u)
+    assert set(np.unique(drawn)) == {0.0, 1.0} and drawn.mean() == pytest.approx(0.3, abs=1e-4)
+    assert np.all(
+        np.diff(drawn) >= 0.0
+    )  # a higher score never gives the lower value (correlations keep their sign)
+    assert x.nominal == 0.0 and Input(x.path, CHOICE, (0.7,)).nominal == 1.0
+    assert (
+        x.sd == pytest.approx(np.sqrt(0.21)) and x.discrete and not Input("a", "normal", (0.0, 1.0)).discrete
+    )

@@ -74,6 +74,7 @@ VEHICLE_KEYS = (
 )
 WHEEL_NAMES = ("front_left", "front_right", "rear_left", "rear_right")
 WHEEL_KEYS = ("state", "brake", "steer")
+STATES = ("rolling", "locked")  # a wheel's state, as the batch column state_k: 0, 1
 SEPARATION_KEYS = ("position", "heading", "velocity", "yaw_rate", "mark_directions")
 REST_KEYS = ("position", "heading")
 INTERMEDIATE_KEYS = ("position", "heading")
@@ -165,6 +166,29 @@ def _wheel(value: Any, path: str) -> tuple[float, float, float]:
     if abs(steer) >= 90.0:
         raise SceneError(f"must be between -90 and 90 degrees, got {steer:g}", f"{path}.steer")
     return (1.0 if state == "locked" else 0.0), brake, math.radians(steer)
+
+
+def locked_probability(value: Mapping, path: str) -> float:
+    """The probability that a wheel was locked, from its state given as
+    probabilities, ``{"locked": p, "rolling": 1 - p}`` (either key alone: the
+    other takes the rest). ``reconstruct --uncertainty`` draws the state from it
+    and the nominal scene takes the more probable one; equal probabilities
+    leave none, a one-line SceneError naming the field."""
+    check_keys(value, STATES, path)
+    if not value:
+        raise SceneError('give the probability of "locked" and/or "rolling"', path)
+    probability = {}
+    for key, raw in value.items():
+        x = _number(raw, f"{path}.{key}")
+        if not 0.0 <= x <= 1.0:
+            raise SceneError(f"must be a probability between 0 and 1, got {show_value(raw)}", f"{path}.{key}")
+        probability[key] = x
+    if len(probability) == 2 and abs(probability["locked"] + probability["rolling"] - 1.0) > 1e-9:
+        raise SceneError(f"the probabilities must sum to 1, got {show_value(dict(value))}", path)
+    locked = probability.get("locked", 1.0 - probability.get("rolling", 0.0))
+    if locked == 0.5:
+        raise SceneError("equal probabilities leave no more probable state for the nominal scene", path)
+    return locked
 
 
 def _wheels(value: Any, path: str) -> dict[str, tuple[float, float, float]]:

@@ -8,7 +8,8 @@ points, the normal ...) and the run-out's leaves, read by the same
 distributions): ``runout.friction``, ``runout.slip_angle_max``,
 ``runout.rolling_resistance``, ``impact.position``, and per vehicle
 ``friction``, ``rest.position``, ``rest.heading``, ``separation.position``,
-``separation.heading``, each wheel's ``brake`` and ``steer``, each tyre-mark
+``separation.heading``, each wheel's ``brake`` and ``steer`` (and ``state`` as
+probabilities of locked and rolling: a CHOICE input, `_state_leaf`), each tyre-mark
 direction (``separation.mark_directions.<wheel>``) and each intermediate pose
 (``intermediate[j].position``, ``.heading``). The impact leaves a run-out also
 uses (mass, yaw inertia, heading, impact point) enter both.
@@ -53,23 +54,26 @@ import numpy as np
 from ..errors import SceneError
 from ..residue import without_json_residue
 from ..scene import load_scene, scene_columns, scene_data
-from ..scene.casefile import LeafReader, domain_reasons, parse_correlations, vehicle_state
+from ..scene.casefile import Leaf, LeafReader, domain_reasons, parse_correlations, vehicle_state
 from ..uncertainty import Source, propagate
 from ..uncertainty.commands import RECONSTRUCT, Command
-from ..uncertainty.inputs import Input
+from ..uncertainty.inputs import CHOICE, Input
 from ..uncertainty.propagation import linear_method, linearity_notes
 from . import _door
 from .batch import columns, run_row, runout_batch
 from .chain import _check, _impact_part, reconstruct_from_rest
 from .drawfit import NOT_CONVERGED, Neighbours, draw_tolerances, fit_draws, variant
 from .fit import evaluate, heading_scale
-from .scene import SLUG, RunoutScene, load_runout, row_values
+from .scene import SLUG, STATES, RunoutScene, load_runout, locked_probability, row_values
 
 FD_TOL = 1e-10  # integrator tolerance of the central differences (docs/runout.md: error ~6e-7 m)
 # Integrator tolerance of the nominal sensitivities: at the default 1e-8 they were 2 % off the
 # central differences of forward run-outs for a braked wheel (chain_solve's SUV; 1e-12: 0.05 %).
 SENS_TOL = 1e-12
 FD_STEP = 1e-2  # of the input's sd
+# The neighbour-search scale of a wheel's locked/rolling choice (m/s per unit, `reach`):
+# far beyond any drawn state's spread, so that draws of other wheel states are never near.
+APART = 1e6
 # Why a draw's fit failed (its rejection reason, after "vehicles[k] run-out: ").
 MISSED = "no separation state reaches the drawn rest pose"
 UNSETTLED = "the least squares over the drawn rest pose, marks and poses did not converge"
@@ -128,7 +132,19 @@ def _nominal_leaves(data: dict, units: str) -> dict:
                 if isinstance(wheel, dict):
                     for key, (dimension, domain) in WHEEL_LEAVES.items():
                         number(wheel, key, f"{p}.wheels.{name}.{key}", dimension, domain)
+                    if isinstance(wheel.get("state"), Mapping):
+                        _state_leaf(wheel, f"{p}.wheels.{name}.state", reader.leaves)
     return reader.leaves
+
+
+def _state_leaf(wheel: dict, path: str, leaves: dict) -> None:
+    """A wheel state given as probabilities (`locked_probability`): a CHOICE leaf
+    (1 locked, 0 rolling; certain probabilities a plain leaf), and in `wheel`
+    the more probable state, the nominal scene's."""
+    locked = locked_probability(wheel["state"], path)
+    kind, params = (CHOICE, (locked,)) if 0.0 < locked < 1.0 else (None, ())
+    leaves[path] = Leaf(path, "number", "any", float(locked > 0.5), kind, params)
+    wheel["state"] = STATES[locked > 0.5]
 
 
 def _with_final(impact: dict, finals) -> dict:
@@ -227,6 +243,7 @@ class Chained:
             row["alpha_max"] = np.deg2rad(values["runout.slip_angle_max"])
         row["f_r"] = values.get("runout.rolling_resistance", row["f_r"])
         for name, key in WHEEL_KEYS.items():
+            row[f"state_{key}"] = values.get(f"{p}.wheels.{name}.state", row[f"state_{key}"])
             row[f"brake_{key}"] = values.get(f"{p}.wheels.{name}.brake", row[f"brake_{key}"])
             steer = values.get(f"{p}.wheels.{name}.steer")
             if steer is not None:
@@ -328,7 +345,10 @@ class Chained:
         the scale of drawfit's neighbour search, where a draw's deviations
         times it place the draws whose fitted states are alike near each other."""
         scale = np.array([1.0, 1.0, heading_scale(vehicle.row)])
-        return np.linalg.norm(self.A[k] * scale[:, None], axis=0)
+        reach = np.linalg.norm(self.A[k] * scale[:, None], axis=0)
+        own = [x.discrete and x.path.startswith(f"vehicles[{k}].") for x in self.inputs]
+        reach[own] = APART  # a draw's neighbours share its wheel states
+        return reach
 
     def linear_columns(self, overrides: Mapping):
         """Reconstruct columns with the separation states linear in the inputs."""
@@ -344,12 +364,15 @@ class Chained:
         """J and A of each vehicle at its nominal fit (module docstring)."""
         names = columns()
         k = len(self.inputs)
-        h = np.array([FD_STEP * x.sd for x in self.inputs])
+        # a choice (a wheel locked or rolling) has no derivative: it stays at its nominal
+        # value, its columns of A and dJ/dx come out zero (the linear method leaves it out)
+        step = np.array([0.0 if x.discrete else FD_STEP * x.sd for x in self.inputs])
+        h = np.where(step > 0.0, step, 1.0)
         x0 = np.array([x.nominal for x in self.inputs])
         grid = np.repeat(x0[None, :], 2 * k, axis=0)
         for j in range(k):
-            grid[2 * j, j] += h[j]
-            grid[2 * j + 1, j] -= h[j]
+            grid[2 * j, j] += step[j]
+            grid[2 * j + 1, j] -= step[j]
         over = {x.path: grid[:, j] for j, x in enumerate(self.inputs)}
         cols, values, _, n = self.split(over) if k else self.split({})
         base_cols, base_values, _, _ = self.split({})
@@ -553,6 +576,12 @@ def chained_uncertainty(scene, draws: int = 10_000, seed: int | None = None, sob
         stats["sd_linear"], u.budget[path] = first_order.get(path, (math.nan, {}))
     # propagate's own sd_linear is NaN here (the exact Source has no Jacobian kernel): noted once, now
     u.notes += linearity_notes(u.outputs, u.accepted, u.n_draws)
+    choices = [x.path for x in chained.inputs if x.discrete]
+    if choices:
+        u.notes.append(
+            f"the linear method holds {', '.join(choices)} at the more probable state: sd_linear and the "
+            "budget leave the wheel states out; the Monte Carlo draws them"
+        )
     return chained, u
 
 

@@ -1,4 +1,4 @@
-"""Uncertain inputs: distributions (normal, uniform, triangular) and their Gaussian copula.
+"""Uncertain inputs: distributions (normal, uniform, triangular, a two-way choice) and their Gaussian copula.
 
 An `Input` is an uncertain leaf of a scene (path, kind, parameters in scene
 units). Draws start as correlated standard-normal scores (Cholesky factor of
@@ -13,12 +13,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Input", "correlation_matrix", "cholesky"]
+__all__ = ["CHOICE", "Input", "correlation_matrix", "cholesky"]
+
+#: The kind of a choice between 0 and 1 (a run-out wheel locked or rolling):
+#: params (probability of 1,).
+CHOICE = "choice"
 
 
 @dataclass(frozen=True)
 class Input:
-    """An uncertain leaf: its path, distribution kind and parameters (scene units)."""
+    """An uncertain leaf: its path, distribution kind and parameters (scene units);
+    kind CHOICE: 1.0 with probability params[0], else 0.0."""
 
     path: str
     kind: str
@@ -26,9 +31,16 @@ class Input:
 
     @property
     def nominal(self) -> float:
-        """Mean (normal), midpoint (uniform) or mode (triangular)."""
+        """Mean (normal), midpoint (uniform) or mode (triangular, choice)."""
         p = self.params
+        if self.kind == CHOICE:
+            return 1.0 if p[0] > 0.5 else 0.0
         return {"normal": p[0], "uniform": (p[0] + p[1]) / 2}.get(self.kind, p[1])
+
+    @property
+    def discrete(self) -> bool:
+        """A choice between two values (no derivative: the linear method leaves it out)."""
+        return self.kind == CHOICE
 
     @property
     def sd(self) -> float:
@@ -38,6 +50,8 @@ class Input:
             return p[1]
         if self.kind == "uniform":
             return (p[1] - p[0]) / math.sqrt(12.0)
+        if self.kind == CHOICE:
+            return math.sqrt(p[0] * (1.0 - p[0]))
         a, c, b = p
         return math.sqrt((a * a + b * b + c * c - a * b - a * c - b * c) / 18.0)
 
@@ -59,6 +73,8 @@ class Input:
             return p[0] + p[1] * _normal_ppf(u)
         if self.kind == "uniform":
             return p[0] + (p[1] - p[0]) * u
+        if self.kind == CHOICE:  # 1 with probability p[0], at the top of u (monotone in the score)
+            return np.where(u > 1.0 - p[0], 1.0, 0.0)
         a, c, b = p
         left = (c - a) / (b - a)
         return np.where(
