@@ -580,7 +580,7 @@ def chained_uncertainty(scene, draws: int = 10_000, seed: int | None = None, sob
     if choices:
         u.notes.append(
             f"the linear method holds {', '.join(choices)} at the more probable state: sd_linear and the "
-            "budget leave the wheel states out; the Monte Carlo draws them"
+            "budget leave the wheel states out; the Monte Carlo draws them (and --sobol's indices weigh them)"
         )
     return chained, u
 
