@@ -142,9 +142,10 @@ def _state_leaf(wheel: dict, path: str, leaves: dict) -> None:
     (1 locked, 0 rolling; certain probabilities a plain leaf), and in `wheel`
     the more probable state, the nominal scene's."""
     locked = locked_probability(wheel["state"], path)
+    nominal = Input(path, CHOICE, (locked,)).nominal
     kind, params = (CHOICE, (locked,)) if 0.0 < locked < 1.0 else (None, ())
-    leaves[path] = Leaf(path, "number", "any", float(locked > 0.5), kind, params)
-    wheel["state"] = STATES[locked > 0.5]
+    leaves[path] = Leaf(path, "number", "any", nominal, kind, params)
+    wheel["state"] = STATES[int(nominal)]
 
 
 def _with_final(impact: dict, finals) -> dict:
