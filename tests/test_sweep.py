@@ -630,3 +630,30 @@ def test_cli_sweep_plot_draws_a_heatmap(tmp_path, capsys):
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     back = pd.read_csv(tmp_path / "map.csv", dtype={"status": "int32", "flags": "int32"})
     assert_same(back, impactsym.sweep(US, e=np.linspace(0, 0.4, 5), mu=np.linspace(0, 0.3, 4)))
+
+
+def test_a_spill_write_asks_no_path_like_question_a_ctrl_c_could_land_in(tmp_path, monkeypatch):
+    """numpy's ndarray.tofile asks whether the file is path-like (Python code of
+    os.PathLike's ABC) and turns a KeyboardInterrupt raised there into a
+    TypeError: a Ctrl-C during a sweep's spill once printed that traceback (CI,
+    tests/test_first_use.py). With every path-like question raising
+    KeyboardInterrupt, the spill still writes and reads back its values."""
+    import os
+
+    from impactsym.batch.quantiles import OrderStatistics
+
+    def interrupted(cls, other):
+        raise KeyboardInterrupt
+
+    stats = OrderStatistics(tmp_path / "spill.bin")
+    monkeypatch.setattr(os.PathLike, "__subclasshook__", classmethod(interrupted))
+    os.PathLike._abc_caches_clear()
+    try:
+        with open(tmp_path / "other.bin", "wb") as other, pytest.raises(KeyboardInterrupt):
+            isinstance(other, os.PathLike)  # the question itself is interrupted
+        values = np.arange(1000.0)[::-1]
+        stats.add(values)
+        assert stats.select([0, 499, 999]) == {0: 0.0, 499: 499.0, 999: 999.0}
+    finally:
+        monkeypatch.undo()
+        os.PathLike._abc_caches_clear()

@@ -204,7 +204,11 @@ class OrderStatistics:
         self._file = open(path, "wb")  # noqa: SIM115 (appended to by add, closed by close/select)
 
     def add(self, values: np.ndarray) -> None:
-        np.ascontiguousarray(values, dtype=np.float64).tofile(self._file)
+        # The file's own write, not ndarray.tofile (nor np.fromfile in `_pass`): numpy
+        # 2.4 turns a KeyboardInterrupt that lands while it asks whether the file is
+        # path-like into a TypeError, and a Ctrl-C during a sweep's spill then printed
+        # a traceback instead of exiting 130 (CI, tests/test_first_use.py).
+        self._file.write(np.ascontiguousarray(values, dtype=np.float64).data)
         self.count += values.size
 
     def close(self) -> None:
@@ -237,7 +241,7 @@ class OrderStatistics:
         parts = {group: [] for group in small}
         counts = {group: np.zeros(_DIGITS, dtype=np.int64) for group in large}
         with open(self.path, "rb") as file:
-            while (values := np.fromfile(file, dtype=np.float64, count=self.READ_BLOCK)).size:
+            while (values := np.frombuffer(file.read(8 * self.READ_BLOCK), dtype=np.float64)).size:
                 keys = _keys(values)
                 for (prefix, bits), kept in parts.items():
                     kept.append(keys[_in_group(keys, prefix, bits)])
