@@ -443,8 +443,10 @@ class Chained:
         in drawfit.py is J + sum_j dJ/dx_j dx_j (a chord step with the nominal J
         alone leaves about a tenth of the miss)."""
         names = columns()
-        slopes = np.empty((len(h), 3, 3))
+        slopes = np.zeros((len(h), 3, 3))
         for j in range(len(h)):
+            if not (np.any(A[:, j]) or np.any(dtheta[j])):
+                continue  # the input does not move this run-out (the other car's, a wheel choice): no slope
             ends = []
             for sign in (1.0, -1.0):
                 row = base + sign * h[j] * dtheta[j]
