@@ -34,7 +34,15 @@ def _set(data, path, value):
     return data
 
 
-_DELETE = object()
+class _Deleted:
+    """The field removed from the scene (a stable name in the test ids, which
+    pytest-xdist's workers must collect alike)."""
+
+    def __repr__(self) -> str:
+        return "<deleted>"
+
+
+_DELETE = _Deleted()
 
 # (statement quoted from the docs, base scene, kind, change (path, value), the field an
 # error must name, or OK when the scene must load)
