@@ -103,6 +103,15 @@ W_LEAVE = 2.0
 # is as long as the stiff one would be) is not tried again for W_WAIT steps
 # (each try costs a Jacobian: a fifth of a step).
 W_WAIT = 10
+# The sensitivities' own local error (docs/runout.md, "Error control of the
+# sensitivities"): in a Dormand-Prince step each entry S of d y/d(vx, vy, w, mu)
+# is held to SENS_SHARE * tol * (1 + |S|). Riding on the state's steps alone
+# they were off by up to 17 % at tol 1e-6 and 3.3 % at 1e-8 on variants of a
+# sticking wheel (a wheel's force crossing its smoothing band kicks them where
+# the state barely moves; in the ROS34PW2 steps the same control changed
+# nothing). 100: 1.0 % and 0.08 % there, 1.2-1.3 times the steps of a run-out
+# with sensitivities (1: 3 times).
+SENS_SHARE = 100.0
 
 # Row status codes of runout_batch (0 solved). 1 and 2 mean what they mean in
 # solve_batch (derive/codes.py); 20-23 are the run-out's own.
@@ -737,6 +746,7 @@ def _w_constants() -> list[str]:
         f"W_ENTER = {W_ENTER!r}  # h |lambda| that hands a step to ROS34PW2",
         f"W_LEAVE = {W_LEAVE!r}  # h |lambda| bound below which Dormand-Prince takes over again",
         f"W_WAIT = {W_WAIT!r}  # Dormand-Prince steps before a refused hand-over is tried again",
+        f"SENS_SHARE = {SENS_SHARE!r}  # a sensitivity S is held to SENS_SHARE tol (1 + |S|) per explicit step",
     ]
 
 
@@ -981,10 +991,12 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
     h |lambda| (Hairer's, from its last two stages) exceeds W_ENTER hands the
     next step to ROS34PW2; a ROS34PW2 step whose h |lambda| (_stiffness, from
     the Jacobian) is below W_LEAVE hands back. The local error of the state
-    (x, y, psi, vx, vy, w) is kept below `tol` (absolute, SI) per step; the
-    distance and the sensitivities ride on the same steps. The step in which
-    the vehicle stops is cut back to where _speed falls through V_STOP
-    (_to_stop). Accepted points go to `path` while it has room: __PATH_DOC__.
+    (x, y, psi, vx, vy, w) is kept below `tol` (absolute, SI) per step, and in
+    a Dormand-Prince step each sensitivity S's below SENS_SHARE tol (1 + |S|)
+    (in the forward kernels, which have none, the steps are the state's
+    alone); the distance rides on the same steps. A step after a rejected
+    trial does not grow. The step in which the vehicle stops is cut back to
+    where _speed falls through V_STOP (_to_stop). Accepted points go to `path` while it has room: __PATH_DOC__.
     Returns (t, status, steps, points). (The stages are a loop with one call of
     the right-hand side, not written out: numba inlines every call site, and
     seven of them tripled the compile time of first use.)"""
@@ -1004,6 +1016,7 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
     taken = False  # the last step was a ROS34PW2 step
     wait = 0  # Dormand-Prince steps before the stiffness is looked at again
     fresh = False  # J holds the Jacobian at y
+    rejected = False  # the last trial was rejected
     if path.shape[0] > 0:
         __PATH_FIRST__
         points = 1
@@ -1026,6 +1039,7 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
             err = _wstep__SUFFIX__(y, P, W, h, k[0], J, K, z, k[1], k[2])/tol
             if not (err <= 1.0):  # rejected (NaN included)
                 h *= 0.1 if not math.isfinite(err) else max(0.2, 0.9*err**(-1.0/3.0))
+                rejected = True
                 continue
             for i in range(n):
                 z[i] = k[2, i]
@@ -1047,8 +1061,14 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
                 for j in range(7):
                     e += DP_E[j]*k[j, i]
                 err = max(err, abs(h*e)/tol)
+            for i in range(7, n):  # the sensitivities (none in the forward kernels)
+                e = 0.0
+                for j in range(7):
+                    e += DP_E[j]*k[j, i]
+                err = max(err, abs(h*e)/(tol*SENS_SHARE*(1.0 + abs(z[i]))))
             if not (err <= 1.0):  # rejected (NaN included)
                 h *= 0.1 if not math.isfinite(err) else max(0.2, 0.9*err**-0.2)
+                rejected = True
                 continue
             # Hairer's stiffness estimate (DOPRI5): |lambda| ~ |k7 - k6|/|z7 - z6|
             num = 0.0
@@ -1079,7 +1099,12 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
             points += 1
         if stopped:
             return t, STATUS_OK, steps, points
-        h = min(h*grow, H_MAX)
+        # Hairer's rule (DOPRI5, RODAS): a step after a rejected trial does not
+        # grow. Without it a kink (a wheel's force entering or leaving its
+        # smoothing band, its lateral force saturating) cost cycles of a step
+        # grown fivefold and rejected (docs/runout.md, "Steps").
+        h = min(h*(min(grow, 1.0) if rejected else grow), H_MAX)
+        rejected = False
 
 
 '''

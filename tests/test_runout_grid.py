@@ -7,8 +7,10 @@ reaching the rest pose; the grid search finds a third, 0.6 rad/s from the
 generating one. Row 13 (every wheel rolling, a 66 m spinning run-out): the fit
 alone names one state, the grid search another (neither is the generating
 state, whose basin is narrower than the grid: docs/runout.md, "The grid search").
-Seed 6, row 13: no start of the fit converges; the grid search, its last
-rescue, finds the generating state (on the fine grid, after the coarse one).
+Seed 6, row 19: no start of the fit converges; the grid search, its last
+rescue, finds the generating state. (Seed 6's row 13 was that row until the
+integrator's steps stopped growing after a rejection: its fit now converges
+from its own starts.)
 """
 
 from __future__ import annotations
@@ -90,7 +92,7 @@ def test_the_grid_finds_another_state_of_row_13():
 
 @pytest.mark.slow
 def test_a_fit_whose_starts_all_fail_is_rescued_by_the_grid():
-    row, rest, vehicle = round_trip(13, seed=6)
+    row, rest, vehicle = round_trip(19, seed=6)
     fit = fit_rest(vehicle)
     assert fit.converged and fit.grid.shape == (31, 31, 33)  # the coarse grid first found nothing
     assert fit.velocity == pytest.approx((row["vx"], row["vy"]), abs=0.01)

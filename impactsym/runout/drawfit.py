@@ -58,7 +58,7 @@ STALL = 0.25  # a trial that does not cut the squared residual by this much rene
 FD_SHARE = 1e-3
 # A draw's fit converges to DRAW_SHARE of the draws' rest-pose spread, at most
 # 1 mm and 1e-4 rad; its run-outs then run at tolerance DRAW_TOL, whose worst
-# rest-position error over the benchmark's random run-outs was 8.6e-5 m
+# rest-position error over the benchmark's random run-outs was 1.45e-4 m
 # (benchmarks/results/runout.md; 1e-6: 3.0e-3 m, more than the tolerance).
 DRAW_SHARE = 0.01
 DRAW_POSITION_TOL, DRAW_HEADING_TOL = 1e-3, 1e-4
@@ -113,7 +113,7 @@ def draw_tolerances(jacobian: np.ndarray, deviations: np.ndarray) -> tuple[tuple
     of what the draws fit: DRAW_SHARE of the rest-pose spread those deviations
     make (J times them), between fit.py's tolerances and (DRAW_POSITION_TOL,
     DRAW_HEADING_TOL); where the position tolerance is the loose one the run-outs
-    run at DRAW_TOL, whose error is a tenth of it."""
+    run at DRAW_TOL, whose worst error is a seventh of it."""
     if deviations.shape[0] < 2:
         return (POSITION_TOL, HEADING_TOL), None
     spread = np.std(deviations @ jacobian.T, axis=0)
