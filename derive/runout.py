@@ -996,7 +996,8 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
     (in the forward kernels, which have none, the steps are the state's
     alone); the distance rides on the same steps. A step after a rejected
     trial does not grow. The step in which the vehicle stops is cut back to
-    where _speed falls through V_STOP (_to_stop). Accepted points go to `path` while it has room: __PATH_DOC__.
+    where _speed falls through V_STOP (_to_stop). Accepted points go to `path`
+    while it has room: __PATH_DOC__.
     Returns (t, status, steps, points). (The stages are a loop with one call of
     the right-hand side, not written out: numba inlines every call site, and
     seven of them tripled the compile time of first use.)"""
