@@ -105,12 +105,15 @@ W_LEAVE = 2.0
 W_WAIT = 10
 # The sensitivities' own local error (docs/runout.md, "Error control of the
 # sensitivities"): in a Dormand-Prince step each entry S of d y/d(vx, vy, w, mu)
-# is held to SENS_SHARE * tol * (1 + |S|). Riding on the state's steps alone
-# they were off by up to 17 % at tol 1e-6 and 3.3 % at 1e-8 on variants of a
-# sticking wheel (a wheel's force crossing its smoothing band kicks them where
-# the state barely moves; in the ROS34PW2 steps the same control changed
-# nothing). 100: 1.0 % and 0.08 % there, 1.2-1.3 times the steps of a run-out
-# with sensitivities (1: 3 times).
+# is held to SENS_SHARE * tol * (1 + |S|). Riding on the state's steps alone,
+# d(x, y, psi)_rest/d(vx, vy, w) at the default tolerance was off central
+# differences by over 5 % on 7 of 60 random rows (worst 15 %; at tol 1e-6 one
+# blew up): a wheel's force crossing its smoothing band kicks them where the
+# state barely moves. With 100: worst 0.5 %, none over 1 %; a run-out with
+# sensitivities takes 1.42 times the steps of the forward one (300 random
+# rows; as many before). 30 and 300 gave the same errors there, but 300 put
+# the T-bone's struck car's d state/d rest heading 35 % off (100: 0.4 %). In
+# the ROS34PW2 steps the same control changed nothing.
 SENS_SHARE = 100.0
 
 # Row status codes of runout_batch (0 solved). 1 and 2 mean what they mean in
