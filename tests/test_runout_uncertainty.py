@@ -347,10 +347,10 @@ def test_draws_started_from_fitted_neighbours_reach_the_same_states_with_fewer_r
         sd = np.std(pa[both], axis=0)
         assert np.all(np.abs(pa[both] - pw[both]) < 0.03 * sd)
     assert sum(w.runouts for w in waves) < 0.5 * sum(a.runouts for a in alone)
-    # the SUV, near-linear, takes a start and one step for most rows when each
-    # starts from its neighbour moved by the neighbour's Jacobian (2.2 run-outs
-    # a row measured; 2.9 unmoved, 3.1 moved the wrong way)
-    assert w1.runouts < 2.5 * w1.state.shape[0]
+    # the SUV, near-linear, starts within its tolerance for most rows from the
+    # local quadratic over its fitted neighbours (1.6 run-outs a row measured;
+    # 2.2 from the nearest neighbour moved by its Jacobian, 2.9 unmoved)
+    assert w1.runouts < 1.9 * w1.state.shape[0]
 
 
 def test_a_linear_method_that_does_not_hold_is_noted():

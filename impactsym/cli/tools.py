@@ -42,14 +42,18 @@ def _add_compile(parser: argparse.ArgumentParser) -> None:
 
 
 def _run_compile(args: argparse.Namespace) -> int:
-    """Compile every batch driver once for this machine, and the loops of
-    exact percentiles."""
+    """Compile every batch driver once for this machine, the loops of
+    exact percentiles and the draws' local fit."""
     from ..batch import selection  # imports numba: only this command needs it
+    from ..runout import neighbours
     from ..runout.batch import compile_drivers
 
     start = time.perf_counter()
     count = (
-        _kernels.compile_all(None if args.quiet else print) + selection.compile_loops() + compile_drivers()
+        _kernels.compile_all(None if args.quiet else print)
+        + selection.compile_loops()
+        + compile_drivers()
+        + neighbours.compile_loops()
     )
     if not args.quiet:
         print(f"compiled or loaded {count} batch drivers and loops in {time.perf_counter() - start:.0f} s")

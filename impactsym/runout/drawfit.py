@@ -5,8 +5,8 @@
 Quasi-Newton across the rows, vectorised with NumPy, every run-out through
 `runout_batch` (forward only: no batch driver integrates the sensitivities),
 in waves (`_waves`): the first FIRST_WAVE rows as below, every later row from
-its nearest fitted row, moved by that row's Jacobian (the caller gives where
-the draws lie: Neighbours).
+a local quadratic fit over the fitted rows near it (neighbours.py; the caller
+gives where the draws lie: Neighbours).
 Each row starts from its linear prediction (the nominal fit plus the linear
 method's dp/dx times the draw's deviation) or, where that misses the rest
 pose by more than FAR, the nominal fitted state if it misses by less, with
@@ -28,11 +28,11 @@ intermediate poses the fit is least squares over the rest pose and them, and
 every row goes to that exact Newton (`_exact_rows`).
 
 Measured (`python -m benchmarks uncertainty --parts runout`, 10^5 draws,
-docs/runout.md): all wheels locked, 3.13 run-outs per draw (two vehicles: the
-start and a Newton step for most rows); the mixed-wheel example
-(examples/runout/chain_reconstruct_uncertain.json), whose sedan spins, 4.86
-(24.5 from the linear prediction alone), and 7 of its 200,000 fits go to the
-exact Newton.
+docs/runout.md): all wheels locked, 2.01 run-outs per draw (two vehicles: the
+start alone for almost every row); the mixed-wheel example
+(examples/runout/chain_reconstruct_uncertain.json), whose sedan spins, 2.67
+(4.86 from the nearest fitted row's Newton step, 24.5 from the linear
+prediction alone), and 7 of its 200,000 fits go to the exact Newton.
 """
 
 from __future__ import annotations
@@ -44,7 +44,7 @@ import math
 import numpy as np
 
 from .._util import require
-from . import threads
+from . import neighbours, threads
 from .batch import columns, runout_batch
 from .fit import HEADING_TOL, POSITION_TOL, newton
 from .scene import RunoutVehicle
@@ -158,14 +158,16 @@ def fit_draws(
 def _waves(table, target, start, nominal, jacobian, vehicle, tol, tols, near: Neighbours) -> DrawFit:
     """The rows in waves, each as large as all before it: the first FIRST_WAVE
     from `start` and `jacobian` (the draws come in random order, so those are a
-    sample of all), every later row from its nearest fitted row j in
-    `near.position` (scipy's cKDTree), moved by that row's last Jacobian B_j:
-    p_j + B_j^-1 (shift_i - shift_j), the Newton step from p_j to first order in
-    the draws' difference, with B_j as its first Jacobian. Where the fitted
-    state is a strongly curved function of the draw, the neighbour's state and
-    Jacobian are far better than the nominal ones (docs/runout.md: the
-    mixed-wheel example's spinning sedan). A wave whose earlier rows all failed
-    starts from `start` instead."""
+    sample of all), every later row from the fitted rows before it: the
+    intercept of a local quadratic fit of their fitted states over its nearest
+    ones in `near.position` (neighbours.py), with the nearest's last Jacobian
+    B_j as its first. Where there are fewer fitted rows than that fit needs,
+    the nearest's Newton step p_j + B_j^-1 (shift_i - shift_j) instead (first
+    order in the draws' difference). Where the fitted state is a strongly
+    curved function of the draw, the neighbours' states and Jacobian are far
+    better than the nominal ones (docs/runout.md, "Draws": the mixed-wheel
+    example's spinning sedan). A wave whose earlier rows all failed starts
+    from `start` instead."""
     tree = require("scipy.spatial", extra="uncertainty", what="the draws' neighbour search").cKDTree
     n = table.shape[0]
     p, status = np.full((n, 3), math.nan), np.zeros(n, dtype=np.int64)
@@ -175,9 +177,17 @@ def _waves(table, target, start, nominal, jacobian, vehicle, tol, tols, near: Ne
     while lo < n:
         rows = np.arange(lo, hi)
         fitted = np.flatnonzero(status[:lo] == 0)
-        if fitted.size:
+        quadratic = (
+            neighbours.predict(near.position[fitted], p[fitted], near.position[rows]) if fitted.size else None
+        )
+        if quadratic is not None:  # the local quadratic's start, kept within the trust region of the nearest
+            moved, j = quadratic
+            j = fitted[j]
+            moved = p[j] + _capped(moved - p[j], p[j])
+        elif fitted.size:  # too few fitted rows for the quadratic: the nearest's Newton step
             j = fitted[tree(near.position[fitted]).query(near.position[rows])[1]]
             moved = p[j] + _capped(_newton_step(B[j], near.shift[j] - near.shift[rows]), p[j])
+        if fitted.size:
             fit, B[rows] = _batched(
                 table[rows], target[rows], moved, nominal, B[j], vehicle, tol, tols, False
             )
