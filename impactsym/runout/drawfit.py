@@ -165,9 +165,9 @@ def _waves(table, target, start, nominal, jacobian, vehicle, tol, tols, near: Ne
     the nearest's Newton step p_j + B_j^-1 (shift_i - shift_j) instead (first
     order in the draws' difference). Where the fitted state is a strongly
     curved function of the draw, the neighbours' states and Jacobian are far
-    better than the nominal ones (docs/runout.md, "Draws": the mixed-wheel
-    example's spinning sedan). A wave whose earlier rows all failed starts
-    from `start` instead."""
+    better than the nominal ones (docs/runout.md, "`reconstruct --uncertainty`
+    through the run-out": the mixed-wheel example's spinning sedan). A wave
+    whose earlier rows all failed starts from `start` instead."""
     tree = require("scipy.spatial", extra="uncertainty", what="the draws' neighbour search").cKDTree
     n = table.shape[0]
     p, status = np.full((n, 3), math.nan), np.zeros(n, dtype=np.int64)

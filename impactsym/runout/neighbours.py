@@ -14,10 +14,11 @@ rest; the offsets scaled by the farthest neighbour's distance, which keeps the
 normal equations well scaled). A first-order step from the nearest fitted draw
 (the rule before this module) misses the drawn rest pose by the fitted
 state's curvature over the neighbour distance; the quadratic takes that
-curvature out. Measured on the mixed-wheel example (docs/runout.md, "Draws"):
-a start within the draw's tolerance for 76 % of the spinning sedan's rows and
-94 % of the SUV's, against 0 % and 6 % from the nearest draw's step and 17 %
-and 29 % from a local linear fit over 16 neighbours.
+curvature out. Measured on the mixed-wheel example (docs/runout.md,
+"`reconstruct --uncertainty` through the run-out"): a start within the draw's
+tolerance for 76 % of the spinning sedan's rows and 94 % of the SUV's, against
+0.7 % and 5.2 % from the nearest draw's step and 17 % and 29 % from a local
+linear fit over 16 neighbours.
 
 Written by hand (numba, over the run-out room's threads): no library we use
 fits a local polynomial per query point at this rate (about 5 microseconds a
