@@ -111,7 +111,7 @@ W_WAIT = 10
 # blew up): a wheel's force crossing its smoothing band kicks them where the
 # state barely moves. With 100: worst 0.5 %, none over 1 %; a run-out with
 # sensitivities takes 1.42 times the steps of the forward one (300 random
-# rows; as many before). 30 and 300 gave the same errors there, but 300 put
+# rows; as many before; 1.27 since the steps land on kinks, KINK_PAST). 30 and 300 gave the same errors there, but 300 put
 # the T-bone's struck car's d state/d rest heading 35 % off (100: 0.4 %). In
 # the ROS34PW2 steps the same control changed nothing.
 SENS_SHARE = 100.0

@@ -142,7 +142,7 @@ def run_row(
     scene on an empty cache 5.3 s instead of 7.6 s, docs/runout.md). Its
     forward part is the forward kernel's model; the sensitivities' own error
     control gives it other steps, so the two differ by their integration
-    errors (worst 0.084 mm over 300 random run-outs at the default tolerance).
+    errors (worst 0.14 mm over 300 random run-outs at the default tolerance).
     Batches use the forward drivers (`runout_batch`)."""
     plain, jit = _door.plain(), _door.jit()
     buffer = np.empty((path_points, path_columns))
