@@ -5,8 +5,9 @@ Rows come from tests/runout_rows.py (the benchmark's round trips, seed 5).
 Row 1 (steered, rolling, locked, locked): the fit alone names two states
 reaching the rest pose; the grid search finds a third, 0.6 rad/s from the
 generating one. Row 13 (every wheel rolling, a 66 m spinning run-out): the fit
-alone names one state, the grid search another (neither is the generating
-state, whose basin is narrower than the grid: docs/runout.md, "The grid search").
+alone names one state, the grid's minima another; the generating state, whose
+basin is narrower than the grid, only the refinement of the grid's open cells
+finds (docs/runout.md, "The grid search"), as it does seed 6 row 18's.
 Seed 6, row 19: no start of the fit converges; the grid search, its last
 rescue, finds the generating state. (Seed 6's row 13 was that row until the
 integrator's steps stopped growing after a rejection: its fit now converges
@@ -76,18 +77,75 @@ def test_the_grid_finds_a_third_state_of_row_1():
     assert any(
         math.hypot(s[0] - truth[0], s[1] - truth[1]) < 0.01 and abs(s[2] - truth[2]) < 0.01 for s in states
     )
-    assert fit.grid.shape == (31, 31, 33) and 0 < len(fit.grid.starts) <= min(
-        grid.MAX_STARTS, fit.grid.minima
+    minima = len(fit.grid.starts) - len(fit.grid.refined.starts)  # the minima's starts come first
+    assert fit.grid.shape == (31, 31, 33) and 0 < minima <= min(grid.MAX_STARTS, fit.grid.minima)
+
+
+def _has(states, row) -> bool:
+    return any(
+        math.hypot(s[0] - row["vx"], s[1] - row["vy"]) < 0.01 and abs(s[2] - row["w"]) < 0.01 for s in states
     )
 
 
 @pytest.mark.slow
-def test_the_grid_finds_another_state_of_row_13():
-    row, rest, vehicle = round_trip(13)
-    plain = _states(fit_rest(vehicle))
-    states = _states(fit_rest(vehicle, exhaustive=True))
-    assert len(states) > len(plain)
-    assert all(reaches(row, s, rest) for s in states) and _distinct(states)
+@pytest.mark.parametrize("seed, index", [(5, 13), (6, 18)])
+def test_the_refined_cells_find_a_generating_state_narrower_than_the_grid(seed, index):
+    """Seed 5 row 13 (every wheel rolling, a 66 m spinning run-out: 0.05 rad/s
+    moves the rest by 13 m) and seed 6 row 18: the grid's local minima miss
+    the generating state (its basin is narrower than the spacing); refining the
+    open cells finds it, and every state named reaches the rest pose (before
+    the refinement, f7f9799 and earlier, neither search named it)."""
+    row, rest, vehicle = round_trip(index, seed)
+    fit = fit_rest(vehicle, exhaustive=True)
+    states = _states(fit)
+    assert _has(states, row) and all(reaches(row, s, rest) for s in states) and _distinct(states)
+    refined = fit.grid.refined
+    assert refined.levels >= 1 and refined.runouts > 0 and len(refined.starts) >= 1
+    assert refined.runouts <= grid.REFINE_RUNOUTS + grid.SETTLE_CELLS * (1 + 4 * grid.SETTLE_ITERATIONS)
+
+
+def _narrow_map(p: np.ndarray) -> np.ndarray:
+    """A map with a wide root at (0, 0, 0) and two within 0.03 of (1, 0, 0),
+    narrower than the test's grid (spacing 0.25): x - 2 exp(-(|p - (1, 0, 0)|/0.03)^2), y, z."""
+    bump = 2.0 * np.exp(-np.sum(((p - np.array([1.0, 0.0, 0.0])) / 0.03) ** 2, axis=-1))
+    return np.stack([p[..., 0] - bump, p[..., 1], p[..., 2]], axis=-1)
+
+
+def _newton_settle(starts, jacobians):
+    """`refine`'s settle for _narrow_map: Newton from each start (forward
+    differences), the distinct states within 1e-9 of a root."""
+    p = np.array(starts, dtype=float)
+    for _ in range(30):
+        f = _narrow_map(p)
+        J = np.stack([(_narrow_map(p + 1e-7 * e) - f) / 1e-7 for e in np.eye(3)], axis=-1)
+        step = np.linalg.solve(J, -f[:, :, None])[:, :, 0]
+        p += step / np.maximum(1.0, np.linalg.norm(step, axis=1) / 0.01)[:, None]  # a trust region of 0.01
+    roots = p[np.linalg.norm(_narrow_map(p), axis=1) < 1e-9]
+    states: list = []
+    for q in roots:
+        if all(np.linalg.norm(q - o) > 1e-6 for o in states):
+            states.append(tuple(q))
+    return states, 0
+
+
+def test_refining_the_open_cells_finds_roots_between_grid_points():
+    """On a grid of spacing 0.25 the narrow roots near (1, 0, 0) leave no local
+    minimum of the miss there; the cells that may hold a root (their corners'
+    box widened by the second differences) are refined three times and settle
+    onto both narrow roots, and the cells far from every root are excluded."""
+    axis = np.linspace(-2.0, 2.0, 17)
+    points = np.stack(np.meshgrid(axis, axis, axis, indexing="ij"), axis=-1)
+    poses = _narrow_map(points)
+    miss = np.sum(poses**2, axis=-1)
+    minima = points[grid._local_minima(miss)]
+    assert np.all(
+        np.linalg.norm(minima - np.array([1.0, 0.0, 0.0]), axis=1) > 0.2
+    )  # none near the narrow pair
+    out = grid.refine(_narrow_map, poses, points[0, 0, 0], np.full(3, 0.25), np.zeros(3), _newton_settle)
+    found = np.array(out.starts)
+    narrow = found[np.abs(found[:, 0] - 1.0) < 0.1]
+    assert len(narrow) == 2 and np.all(np.abs(narrow[:, 1:]) < 1e-9)
+    assert out.levels == grid.REFINE_LEVELS and out.open_cells < 0.02 * 16**3
 
 
 @pytest.mark.slow
@@ -128,6 +186,8 @@ def test_the_cli_reports_the_search_in_json(capsys):
         search = v["fit"]["search"]
         assert search["grid"] == [31, 31, 33] and search["runouts"] == 23397
         assert search["states"] >= 1 and 0 < search["starts"] <= min(search["minima"], grid.MAX_STARTS)
+        refined = search["refined"]
+        assert refined["levels"] >= 1 and refined["runouts"] > 0 and refined["open_cells"] >= 1
         assert search["spacing"]["speed"] == pytest.approx(search["speed_max"] / grid.SPEED_CELLS)
     code, out, _ = run_cli(capsys, "runout", EXAMPLES / "runout" / "fit_tbone.json", "--exhaustive")
     assert code == 0 and out.count("grid search:") == 2

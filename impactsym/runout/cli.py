@@ -231,11 +231,19 @@ def table(result: dict) -> str:
 
 
 def _search_line(search: dict, unit: str) -> str:
-    """The grid search of a fitted vehicle, one line."""
+    """The grid search of a fitted vehicle, one line (and its refinement's)."""
     n = search["states"]
-    return (
+    line = (
         f"  grid search: {search['runouts']} run-outs, speed up to {search['speed_max']:.3g} {unit}/s "
         f"(spacing {search['spacing']['speed']:.2g}), yaw rate within +-{search['yaw_rate_max']:.3g} rad/s "
         f"(spacing {search['spacing']['yaw_rate']:.2g}), Newton from {search['starts']} of its "
-        f"{search['minima']} local minima: {n} state{' reaches' if n == 1 else 's reach'} the rest pose"
+        f"{search['minima']} local minima"
     )
+    r = search.get("refined")
+    if r and r["open_cells"]:
+        line += (
+            f" and {r['starts']} state{'' if r['starts'] == 1 else 's'} reached from its {r['open_cells']} open "
+            f"cells refined {r['levels']} level{'' if r['levels'] == 1 else 's'} deep (to spacing {r['spacing']['speed']:.2g}, "
+            f"{r['spacing']['yaw_rate']:.2g}; {r['runouts']} run-outs, {r['still_open']} cells still open)"
+        )
+    return line + f": {n} state{' reaches' if n == 1 else 's reach'} the rest pose"

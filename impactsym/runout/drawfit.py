@@ -2,28 +2,22 @@
 (vx, vy, w) per row of a run-out table, for the Monte Carlo draws of
 ``reconstruct --uncertainty`` through the run-out (uncertain.py).
 
-Quasi-Newton across the rows, vectorised with NumPy, every run-out through
-`runout_batch` (forward only: no batch driver integrates the sensitivities),
-in waves (`_waves`): the first FIRST_WAVE rows as below, every later row from
-a local quadratic fit over the fitted rows near it (neighbours.py; the caller
-gives where the draws lie: Neighbours).
+Quasi-Newton across the rows (batchfit.py: Broyden's Jacobians, trust region,
+forward differences where Broyden stalls), every run-out forward through
+`runout_batch` (no batch driver integrates the sensitivities), in waves
+(`_waves`): the first FIRST_WAVE rows as below, every later row from a local
+quadratic fit over the fitted rows near it (neighbours.py; the caller gives
+where the draws lie: Neighbours).
 Each row starts from its linear prediction (the nominal fit plus the linear
 method's dp/dx times the draw's deviation) or, where that misses the rest
 pose by more than FAR, the nominal fitted state if it misses by less, with
 the exact Jacobian J = d(x, y, psi)_rest/d(vx, vy, w) of the nominal fit
 moved to first order to the draw (the caller's; heading residuals weighted by
-the vehicle's R_max, as in fit.py). An iteration solves B s = -r for every open
-row (NumPy's batched 3x3 solve), shortens s to a trust region (`_capped`),
-runs the trials, takes every trial whose run-out ran and whose miss did not
-grow more than GROWTH times (full, non-monotone steps: in the curved valleys
-of a spinning car a Newton step may first miss by more and then converge,
-where a descent rule crawls), and updates B by Broyden's rank-one formula.
-A row whose trial did not cut its squared miss fourfold gets a fresh B from
-forward differences of three run-outs. A row is converged within `draw_tolerances`:
+the vehicle's R_max, as in fit.py). A row is converged within `draw_tolerances`:
 1 % of the draws' rest-pose spread, between fit.py's tolerances (0.1 mm,
 1e-5 rad) and 1 mm, 0.01 deg; at 1 mm the run-outs run at the looser
 integrator tolerance DRAW_TOL where the first rows fitted show it holds
-(`_tolerance_holds`). Rows still open after MAX_ITERATIONS go to
+(`_tolerance_holds`). Rows still open after batchfit's iterations go to
 fit.py's exact Newton, a row per task on the room's threads; a row that does
 not converge there is reported as not fitted. With tyre-mark directions or
 intermediate poses the fit is least squares over the rest pose and them, and
@@ -46,18 +40,13 @@ import math
 import numpy as np
 
 from .._util import require
-from . import neighbours, threads
-from .batch import columns, runout_batch
+from . import batchfit, neighbours, threads
+from .batch import columns
 from .fit import HEADING_TOL, POSITION_TOL, newton
 from .scene import RunoutVehicle
 
-MAX_ITERATIONS = 20  # batched trials before a row goes to the exact Newton
 FIRST_WAVE = 128  # rows fitted from the linear prediction before neighbours start the rest (_waves)
-GROWTH = 100.0  # a trial missing by more than this times the current miss is not taken
-STEP_SHARE, STEP_SPEED, STEP_YAW = 0.5, 2.0, 2.0  # trust region of a step (m/s, rad/s)
 FAR = 0.05  # m (heading weighted by R_max): a start missing by more also tries the nominal state
-STALL = 0.25  # a trial that does not cut the squared residual by this much renews the Jacobian
-FD_SHARE = 1e-3
 # A draw's fit converges to DRAW_SHARE of the draws' rest-pose spread, at most
 # 1 mm and 0.01 deg (the issue's accuracy of a rest pose); its run-outs then run
 # at tolerance DRAW_TOL where the position tolerance is 1 mm, once the first
@@ -100,19 +89,6 @@ class DrawFit:
     runouts: int
     exact_rows: int
     tol: float | None = None
-
-
-def _residual(table: np.ndarray, p: np.ndarray, target: np.ndarray, tol):
-    """Rest-pose residuals (rows, 3) of the separation states p, and the kernel status."""
-    cols = {name: table[:, j] for j, name in enumerate(columns())}
-    cols["vx"], cols["vy"], cols["w"] = p[:, 0], p[:, 1], p[:, 2]
-    out = runout_batch(cols, tol=tol)
-    rest = np.column_stack([out["x_rest"], out["y_rest"], out["psi_rest"]])
-    return rest - target, out["status"]
-
-
-def _done(r: np.ndarray, tols: tuple[float, float]) -> np.ndarray:
-    return (np.hypot(r[:, 0], r[:, 1]) < tols[0]) & (np.abs(r[:, 2]) < tols[1])
 
 
 def draw_tolerances(jacobian: np.ndarray, deviations: np.ndarray) -> tuple[tuple[float, float], float | None]:
@@ -190,8 +166,8 @@ def _tolerance_holds(table, p, tol: float, tols: tuple[float, float]) -> tuple[b
     if not rows.size:
         return False, 0
     zero = np.zeros((rows.size, 3))
-    loose, _ = _residual(table[rows], p[rows], zero, tol)
-    tight, status = _residual(table[rows], p[rows], zero, CHECK_TOL)
+    loose, _ = batchfit.residual(table[rows], p[rows], zero, tol)
+    tight, status = batchfit.residual(table[rows], p[rows], zero, CHECK_TOL)
     d = (loose - tight)[status == 0]
     holds = (np.hypot(d[:, 0], d[:, 1]) <= CHECK_SHARE * tols[0]).all() and (
         np.abs(d[:, 2]) <= CHECK_SHARE * tols[1]
@@ -229,10 +205,10 @@ def _waves(table, target, start, nominal, jacobian, vehicle, tol, tols, near: Ne
         if quadratic is not None:  # the local quadratic's start, kept within the trust region of the nearest
             moved, j = quadratic
             j = fitted[j]
-            moved = p[j] + _capped(moved - p[j], p[j])
+            moved = p[j] + batchfit.capped(moved - p[j], p[j])
         elif fitted.size:  # too few fitted rows for the quadratic: the nearest's Newton step
             j = fitted[tree(near.position[fitted]).query(near.position[rows])[1]]
-            moved = p[j] + _capped(_newton_step(B[j], near.shift[j] - near.shift[rows]), p[j])
+            moved = p[j] + batchfit.capped(batchfit.newton_step(B[j], near.shift[j] - near.shift[rows]), p[j])
         if fitted.size:
             fit, B[rows] = _batched(
                 table[rows], target[rows], moved, nominal, B[j], vehicle, tol, tols, False
@@ -257,12 +233,9 @@ def _batched(table, target, start, nominal, jacobian, vehicle, tol, tols, try_no
     DrawFit and the rows' last Jacobians (rows, 3, 3; unweighted). Without
     `try_nominal` no row tries the nominal state (the starts are fitted neighbours)."""
     n = table.shape[0]
-    names = columns()
-    a, wb, track = (table[:, names.index(c)] for c in ("a", "L", "track"))
-    radius = np.hypot(np.maximum(a, wb - a), track / 2)
-    weight = np.column_stack([np.ones(n), np.ones(n), radius])  # heading residual in metres
+    weight = batchfit.weights(table)
     p = np.array(start, dtype=np.float64, copy=True)
-    r, status = _residual(table, p, target, tol)
+    r, status = batchfit.residual(table, p, target, tol)
     r *= weight
     runouts = n
     # Where the linear prediction misses by more than FAR, the nominal state is
@@ -271,36 +244,16 @@ def _batched(table, target, start, nominal, jacobian, vehicle, tol, tols, try_no
     far = np.flatnonzero((status != 0) | (np.einsum("ni,ni->n", r, r) > FAR**2)) if try_nominal else ()
     if len(far):
         other = np.broadcast_to(nominal, (far.size, 3))
-        ro, so = _residual(table[far], other, target[far], tol)
+        ro, so = batchfit.residual(table[far], other, target[far], tol)
         ro *= weight[far]
         runouts += far.size
         better = (so == 0) & (
             (status[far] != 0) | (np.einsum("ni,ni->n", ro, ro) < np.einsum("ni,ni->n", r[far], r[far]))
         )
         p[far[better]], r[far[better]], status[far[better]] = other[better], ro[better], 0
-    B = jacobian * weight[:, :, None]
     failed = status != 0
-    open_ = ~failed & ~_done(r / weight, tols)
-    for _ in range(MAX_ITERATIONS):
-        rows = np.flatnonzero(open_)
-        if rows.size == 0:
-            break
-        step = _capped(_newton_step(B[rows], r[rows]), p[rows])
-        trial = p[rows] + step
-        rt, st = _residual(table[rows], trial, target[rows], tol)
-        rt *= weight[rows]
-        runouts += rows.size
-        before, after = np.einsum("ni,ni->n", r[rows], r[rows]), np.einsum("ni,ni->n", rt, rt)
-        # Full steps, not monotone: in a curved valley a Newton step may first
-        # miss by more and then converge (a descent rule crawls there).
-        take = (st == 0) & (after < GROWTH**2 * before)
-        _broyden(B, rows[take], step[take], rt[take] - r[rows[take]])
-        p[rows[take]], r[rows[take]] = trial[take], rt[take]
-        open_[rows[take]] = ~_done(rt[take] / weight[rows[take]], tols)
-        slow = rows[open_[rows] & ~(take & (after < STALL * before))]
-        if slow.size:  # Broyden's Jacobian is not leading: differences of forward run-outs instead
-            B[slow] = _differences(table[slow], p[slow], r[slow], target[slow], weight[slow], tol)
-            runouts += 3 * slow.size
+    p, r, open_, B, spent = batchfit.quasi_newton(table, target, p, r, failed, jacobian, weight, tol, tols)
+    runouts += spent
     exact = np.flatnonzero(open_)
     refit = functools.partial(_exact, vehicle, table, target, p, tol)
     for i, fit in zip(exact, threads.pool().map(refit, exact)):
@@ -309,7 +262,7 @@ def _batched(table, target, start, nominal, jacobian, vehicle, tol, tols, try_no
             open_[i] = False
     out = np.where(failed, RUN_FAILED, np.where(open_, NOT_CONVERGED, 0))
     p[out != 0] = math.nan
-    return DrawFit(p, out, runouts, int(exact.size), tol), B / weight[:, :, None]
+    return DrawFit(p, out, runouts, int(exact.size), tol), B
 
 
 def _exact(vehicle: RunoutVehicle, table, target, p, tol, i: int, evidence=None):
@@ -331,52 +284,6 @@ def _exact_rows(vehicle: RunoutVehicle, table, target, start, evidence, tol) -> 
         p[i], status[i] = (*fit.velocity, fit.yaw_rate), 0 if fit.converged else NOT_CONVERGED
     p[status != 0] = math.nan
     return DrawFit(p, status, 0, int(p.shape[0]))
-
-
-def _differences(table, p, r, target, weight, tol) -> np.ndarray:
-    """Jacobians (rows, 3, 3) of the weighted residual by forward differences of
-    forward run-outs (steps 1e-4 of the speed or yaw rate, at least 1e-4)."""
-    m = p.shape[0]
-    h = np.column_stack(
-        [np.maximum(FD_SHARE * np.hypot(p[:, 0], p[:, 1]), FD_SHARE)] * 2
-        + [np.maximum(FD_SHARE * np.abs(p[:, 2]), FD_SHARE)]
-    )
-    moved = np.repeat(p[None], 3, axis=0)
-    for j in range(3):
-        moved[j, :, j] += h[:, j]
-    rt, _ = _residual(np.tile(table, (3, 1)), moved.reshape(3 * m, 3), np.tile(target, (3, 1)), tol)
-    rt = rt.reshape(3, m, 3) * weight[None]
-    return np.stack([(rt[j] - r) / h[:, j, None] for j in range(3)], axis=2)
-
-
-def _newton_step(B: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """Newton steps B s = -r, row by row (NumPy's batched 3x3 solve; a singular
-    B gives the least-squares step)."""
-    try:
-        return np.linalg.solve(B, -r[:, :, None])[:, :, 0]
-    except np.linalg.LinAlgError:
-        return np.stack([np.linalg.lstsq(b, -x, rcond=None)[0] for b, x in zip(B, r)])
-
-
-def _capped(step: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """`step` shortened to the trust region: the velocity change at most
-    STEP_SHARE of the speed (and at least STEP_SPEED m/s), the yaw-rate change
-    at most STEP_SHARE of |w| (at least STEP_YAW rad/s). A trial far outside it
-    can roll for minutes of simulated time and hold up the whole batch."""
-    dv = np.hypot(step[:, 0], step[:, 1]) / np.maximum(STEP_SHARE * np.hypot(p[:, 0], p[:, 1]), STEP_SPEED)
-    dw = np.abs(step[:, 2]) / np.maximum(STEP_SHARE * np.abs(p[:, 2]), STEP_YAW)
-    return step / np.maximum(1.0, np.maximum(dv, dw))[:, None]
-
-
-def _broyden(B: np.ndarray, rows: np.ndarray, s: np.ndarray, y: np.ndarray) -> None:
-    """Broyden's update of the Jacobians B[rows] from steps s and residual
-    changes y: B += (y - B s) s' / (s' s)."""
-    if rows.size == 0:
-        return
-    Bs = np.einsum("nij,nj->ni", B[rows], s)
-    ss = np.einsum("ni,ni->n", s, s)
-    ok = ss > 0
-    B[rows[ok]] += (y - Bs)[ok, :, None] * s[ok, None, :] / ss[ok, None, None]
 
 
 def variant(vehicle: RunoutVehicle, row: np.ndarray, target: np.ndarray, marks=None, via=()) -> RunoutVehicle:

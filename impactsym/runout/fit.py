@@ -475,7 +475,7 @@ def _search(vehicle: RunoutVehicle, tol, check_unique: bool, span=None) -> Fit:
                     if g is not None and all(_distinct(g, h) for h in found):
                         found.append(g)
             break
-    grid = None if span is None else _grid_states(vehicle, tol, span, found)
+    grid = None if span is None else _grid_states(vehicle, tol, span, found, refined=True)
     if not found and span is None:  # every start failed: the grid search is the last rescue
         for cells in RESCUE_CELLS:
             grid = _grid_states(vehicle, tol, plausible_range(vehicle), found, cells)
@@ -494,13 +494,19 @@ def _search(vehicle: RunoutVehicle, tol, check_unique: bool, span=None) -> Fit:
 
 
 def _grid_states(
-    vehicle: RunoutVehicle, tol, span, found: list, cells=(grids.SPEED_CELLS, grids.YAW_CELLS)
+    vehicle: RunoutVehicle,
+    tol,
+    span,
+    found: list,
+    cells=(grids.SPEED_CELLS, grids.YAW_CELLS),
+    refined: bool = False,
 ) -> grids.Grid:
-    """Run the grid search over `span` (at `cells`) and
-    Newton (to the full tolerances) from each of its starts on the room's
-    threads; append to `found` every converged state distinct from those
-    already there. Returns the search."""
-    grid = grids.scan(vehicle, *span, heading_scale(vehicle.row), LOOSE_TOL, cells)
+    """Run the grid search over `span` (at `cells`; with `refined`, its open
+    cells refined: grid.py) and Newton (to the full tolerances) from each of
+    its starts on the room's threads; append to `found` every converged state
+    distinct from those already there. Returns the search."""
+    apart = (DISTINCT_SPEED, DISTINCT_YAW) if refined else None
+    grid = grids.scan(vehicle, *span, heading_scale(vehicle.row), LOOSE_TOL, cells, apart)
     for g in threads.pool().map(functools.partial(newton, vehicle, tol=tol), grid.starts):
         if g.converged and all(_distinct(g, h) for h in found):
             found.append(g)
