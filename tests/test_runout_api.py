@@ -291,7 +291,7 @@ def test_loosely_determined_yaw_rate_is_named_in_the_warnings():
     quotes the reported determination; the T-bone's fits are not named."""
     from impactsym.runout.api import LOOSE, READING
     from impactsym.runout.chain import reconstruct_from_rest
-    from impactsym.runout.uncertain import nominal_data
+    from impactsym.runout.leaves import nominal_data
 
     data, _, _ = nominal_data(ROOT / "examples" / "runout" / "chain_reconstruct_uncertain.json")
     out = reconstruct_from_rest(data)

@@ -110,7 +110,7 @@ def run_chained(args: argparse.Namespace, command: str) -> int:
     if getattr(args, "plot", None):
         raise SceneError("draw a chained scene's run-outs with impactsym runout SCENE --plot", "--plot")
     from .chain import reconstruct_from_rest, solve_to_rest
-    from .uncertain import nominal_data
+    from .leaves import nominal_data
 
     if command == "solve":
         result = solve_to_rest(args.scene)

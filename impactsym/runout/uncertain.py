@@ -55,17 +55,18 @@ import numpy as np
 from ..errors import SceneError
 from ..residue import without_json_residue
 from ..scene import load_scene, scene_columns, scene_data
-from ..scene.casefile import Leaf, LeafReader, domain_reasons, parse_correlations, vehicle_state
+from ..scene.casefile import parse_correlations
 from ..uncertainty import Source, propagate
 from ..uncertainty.commands import RECONSTRUCT, Command
-from ..uncertainty.inputs import CHOICE, Input
+from ..uncertainty.inputs import Input
 from ..uncertainty.propagation import linear_method, linearity_notes
 from . import _door
 from .batch import columns, run_row, runout_batch
-from .chain import _check, _impact_part, reconstruct_from_rest
+from .chain import reconstruct_from_rest
 from .drawfit import NOT_CONVERGED, Neighbours, draw_tolerances, fit_draws, variant
 from .fit import evaluate, heading_scale
-from .scene import SLUG, STATES, RunoutScene, load_runout, locked_probability, row_values
+from .leaves import WHEEL_KEYS, nominal_data, runout_reasons, with_final
+from .scene import SLUG, RunoutScene, load_runout, row_values
 
 FD_TOL = 1e-10  # integrator tolerance of the central differences (docs/runout.md: error ~6e-7 m)
 # Integrator tolerance of the nominal sensitivities: at the default 1e-8 they were 2 % off the
@@ -78,84 +79,8 @@ APART = 1e6
 # Why a draw's fit failed (its rejection reason, after "vehicles[k] run-out: ").
 MISSED = "no separation state reaches the drawn rest pose"
 UNSETTLED = "the least squares over the drawn rest pose, marks and poses did not converge"
-RUNOUT_LEAVES = {
-    "friction": ("number", "positive"),
-    "slip_angle_max": ("angle", "positive"),
-    "rolling_resistance": ("number", "nonnegative"),
-}
-WHEEL_LEAVES = {"brake": ("number", "nonnegative"), "steer": ("angle", "any")}
-WHEEL_KEYS = {"front_left": "fl", "front_right": "fr", "rear_left": "rl", "rear_right": "rr"}
 #: Run-out columns whose sensitivity the kernel integrates or the module doc derives.
 KNOWN = ("vx", "vy", "w", "mu", "x", "y", "psi")
-
-
-def _nominal_leaves(data: dict, units: str) -> dict:
-    """Read the run-out's leaves of `data` (changed in place: each becomes its
-    nominal number in scene units) and return them, path -> Leaf. Entries of
-    the wrong type are left for load_runout to name."""
-    reader = LeafReader(units)
-
-    def number(block: dict, key: str, path: str, dimension: str, domain: str = "any") -> None:
-        if key in block:
-            block[key] = reader.number(block[key], path, dimension, domain)
-
-    def pair(block: dict, key: str, path: str) -> None:
-        if isinstance(block.get(key), (list, tuple)):
-            reader.vector(block[key], path, "length")
-            block[key] = [reader.leaves[f"{path}[{i}]"].nominal for i in (0, 1)]
-
-    if isinstance(data.get("runout"), dict):
-        for key, (dimension, domain) in RUNOUT_LEAVES.items():
-            number(data["runout"], key, f"runout.{key}", dimension, domain)
-    if isinstance(data.get("impact"), dict):
-        pair(data["impact"], "position", "impact.position")
-    for i, v in enumerate(data.get("vehicles") or []):
-        if not isinstance(v, dict):
-            continue
-        p = f"vehicles[{i}]"
-        number(v, "friction", f"{p}.friction", "number", "positive")
-        number(v, "cg_height", f"{p}.cg_height", "length", "nonnegative")
-        for block in ("rest", "separation"):
-            if isinstance(v.get(block), dict):
-                pair(v[block], "position", f"{p}.{block}.position")
-                number(v[block], "heading", f"{p}.{block}.heading", "angle")
-        marks = v["separation"].get("mark_directions") if isinstance(v.get("separation"), dict) else None
-        if isinstance(marks, dict):
-            for name in WHEEL_KEYS:
-                number(marks, name, f"{p}.separation.mark_directions.{name}", "angle")
-        poses = v.get("intermediate")
-        for j, pose in enumerate(poses if isinstance(poses, list) else []):
-            if isinstance(pose, dict):
-                pair(pose, "position", f"{p}.intermediate[{j}].position")
-                number(pose, "heading", f"{p}.intermediate[{j}].heading", "angle")
-        if isinstance(v.get("wheels"), dict):
-            for name, wheel in v["wheels"].items():
-                if isinstance(wheel, dict):
-                    for key, (dimension, domain) in WHEEL_LEAVES.items():
-                        number(wheel, key, f"{p}.wheels.{name}.{key}", dimension, domain)
-                    if isinstance(wheel.get("state"), Mapping):
-                        _state_leaf(wheel, f"{p}.wheels.{name}.state", reader.leaves)
-    return reader.leaves
-
-
-def _state_leaf(wheel: dict, path: str, leaves: dict) -> None:
-    """A wheel state given as probabilities (`locked_probability`): a CHOICE leaf
-    (1 locked, 0 rolling; certain probabilities a plain leaf), and in `wheel`
-    the more probable state, the nominal scene's."""
-    locked = locked_probability(wheel["state"], path)
-    nominal = Input(path, CHOICE, (locked,)).nominal
-    kind, params = (CHOICE, (locked,)) if 0.0 < locked < 1.0 else (None, ())
-    leaves[path] = Leaf(path, "number", "any", nominal, kind, params)
-    wheel["state"] = STATES[int(nominal)]
-
-
-def _with_final(impact: dict, finals) -> dict:
-    """The impact part with each vehicle's final velocity and yaw rate set (scene units)."""
-    out = copy.deepcopy(impact)
-    for v, (vx, vy, w) in zip(out["vehicles"], finals):
-        v["final_velocity"], v["final_yaw_rate"] = [vx, vy], w
-    out.pop("correlations", None)  # read below with the run-out's leaves too
-    return out
 
 
 @dataclass
@@ -217,7 +142,7 @@ class Chained:
         sc = scene_columns(self.impact, impact)
         n = max([sc.rows] + [a.shape[0] for a in arrays.values()])
         reason = np.broadcast_to(sc.reason, (n,)).copy()
-        own = _runout_reasons(self.leaves, arrays, n)
+        own = runout_reasons(self.leaves, arrays, n)
         reason[reason == ""] = own[reason == ""]
         values = {path: leaf.nominal for path, leaf in self.leaves.items()}
         values.update(arrays)
@@ -498,20 +423,6 @@ class Chained:
         return out
 
 
-def _runout_reasons(leaves: Mapping, arrays: Mapping, n: int) -> np.ndarray:
-    """Per row, why drawn run-out leaves are out of their domain ("" if not)."""
-    reason = domain_reasons(leaves, arrays, n)
-    for path, a in arrays.items():
-        if path.endswith(".brake"):
-            bad, why = a > 1.0, "above 1"
-        elif path.endswith(".steer") or path == "runout.slip_angle_max":
-            bad, why = np.abs(a) >= 90.0, "90 degrees or more"
-        else:
-            continue
-        reason[np.broadcast_to(bad, (n,)) & (reason == "")] = f"{path} is {why}"
-    return reason
-
-
 def _outputs(c: Mapping, o: Mapping) -> dict:
     """The reconstruct outputs and each vehicle's fitted separation motion (complex-safe)."""
     out = RECONSTRUCT.outputs(c, o)
@@ -521,33 +432,6 @@ def _outputs(c: Mapping, o: Mapping) -> dict:
         out[f"{p}.velocity[0]"], out[f"{p}.velocity[1]"] = vx, vy
         out[f"{p}.speed"], out[f"{p}.yaw_rate"] = np.sqrt(vx * vx + vy * vy), c[f"W{i}"]
     return out
-
-
-def nominal_data(scene) -> tuple[dict, dict, dict]:
-    """(the scene with every leaf the run-out reads a plain number in scene
-    units: its nominal value; the run-out's leaves; the impact part as given,
-    distributions kept) of a reconstruct-from-rest scene. The plain chained
-    ``reconstruct`` solves the first (conventions.md: the plain commands solve
-    the nominal scene)."""
-    data = copy.deepcopy(scene_data(scene))
-    if not isinstance(data, dict) or data.get("units") not in ("SI", "US"):
-        load_runout(data)  # names what is wrong
-    leaves = _nominal_leaves(data, data["units"])
-    if len(_check(data)) != len(data["vehicles"]):
-        reconstruct_from_rest(data)  # names the vehicle without run-out data
-    impact = _impact_part(data)
-    placeholder = load_scene(_with_final(impact, [(0.0, 0.0, 0.0)] * 2), kind="reconstruct")
-    nominal = {path: leaf.nominal for path, leaf in placeholder.leaves.items()}
-    for i, v in enumerate(data["vehicles"]):
-        state = vehicle_state(nominal, i, data["units"])
-        for key in ("weight", "radius_of_gyration"):
-            v.pop(key, None)
-        v.update(
-            mass=float(state["m"]), yaw_inertia=float(state["I"]), impact_point=[float(x) for x in state["r"]]
-        )
-        if state["heading"] is not None:
-            v["heading"] = float(state["heading"])
-    return data, leaves, impact
 
 
 def load_chained(scene) -> Chained:
@@ -565,7 +449,7 @@ def load_chained(scene) -> Chained:
         v.get("separation", {}).pop("yaw_rate", None)
     runout_scene = load_runout(ro)
     length = runout_scene.length()
-    impact_scene = load_scene(_with_final(impact, finals), kind="reconstruct")
+    impact_scene = load_scene(with_final(impact, finals), kind="reconstruct")
     everything = {**impact_scene.leaves, **leaves}
     uncertain = [leaf for leaf in everything.values() if leaf.kind is not None]
     inputs = tuple(Input(leaf.path, leaf.kind, tuple(leaf.params)) for leaf in uncertain)
