@@ -24,7 +24,7 @@ intermediate poses the fit is least squares over the rest pose and them, and
 every row goes to that exact Newton (`_exact_rows`).
 
 Measured (`python -m benchmarks uncertainty --parts runout`, 10^5 draws,
-docs/runout.md): all wheels locked, 2.06 run-outs per draw (two vehicles: the
+docs/runout.md): all wheels locked, 2.01 run-outs per draw (two vehicles: the
 start alone for almost every row); the mixed-wheel example
 (examples/runout/chain_reconstruct_uncertain.json), whose sedan spins, 2.61
 (4.86 from the nearest fitted row's Newton step, 24.5 from the linear
@@ -53,7 +53,7 @@ FAR = 0.05  # m (heading weighted by R_max): a start missing by more also tries 
 # rows fitted show its error small enough there (`_tolerance_holds`). Measured
 # against 1e-12 on 6,000 of the mixed-wheel example's drawn run-outs (docs/runout.md):
 # worst rest-position error 2.3e-4 m and heading 3.5e-5 rad at 3e-7 (1e-7:
-# 6.3e-5 m, 1.5e-5 rad; 1e-6: 2.3e-4 m, 6.0e-5 rad), 15 % fewer steps than at 1e-7.
+# 6.3e-5 m, 1.5e-5 rad; 1e-6: 2.3e-4 m, 6.0e-5 rad), 13-14 % fewer steps than at 1e-7.
 DRAW_SHARE = 0.01
 DRAW_POSITION_TOL, DRAW_HEADING_TOL = 1e-3, math.radians(0.01)
 DRAW_TOL = 3e-7

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 from itertools import product
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
 from . import batchfit
 from .batch import columns, runout_batch
@@ -51,6 +52,7 @@ MAX_STARTS = 24  # local minima started from, least miss first
 # that does not reach the rest pose (docs/runout.md, "The grid search").
 REFINE_LEVELS = 3  # halvings of the spacing
 REFINE_RUNOUTS = 24_000
+NEW_POINTS = 19  # run-outs to halve a cell: its 3 x 3 x 3 points but the 8 corners it has
 SETTLE_CELLS = 1_000  # open cells of the finest level the quasi-Newton starts from
 SETTLE_ITERATIONS = 8
 SETTLE_TOLS = (1e-2, 1e-3)  # m, rad: near enough for fit.py's Newton to polish
@@ -201,25 +203,9 @@ def refine(reach, poses: np.ndarray, origin, spacing, target: np.ndarray, settle
     )
 
 
-NEW_POINTS = 19  # run-outs to halve a cell: its 3 x 3 x 3 points but the 8 corners it has
-
-
 def _corners(a: np.ndarray) -> np.ndarray:
-    """(n0 - 1, n1 - 1, n2 - 1, 2, 2, 2, ...): each cell's corner values of the grid array `a`."""
-    n0, n1, n2 = a.shape[:3]
-    return np.stack(
-        [
-            np.stack(
-                [
-                    np.stack([a[i : n0 - 1 + i, j : n1 - 1 + j, k : n2 - 1 + k] for k in (0, 1)], 3)
-                    for j in (0, 1)
-                ],
-                3,
-            )
-            for i in (0, 1)
-        ],
-        3,
-    )
+    """(n0 - 1, n1 - 1, n2 - 1, 2, 2, 2, c): each cell's corner values of the grid array `a` (n0, n1, n2, c)."""
+    return np.moveaxis(sliding_window_view(a, (2, 2, 2), axis=(0, 1, 2)), 3, -1)
 
 
 def _second_differences(a: np.ndarray) -> np.ndarray:
