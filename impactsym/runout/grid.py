@@ -47,13 +47,13 @@ SPEED_CELLS = 15  # grid points each side of zero along vx and along vy
 YAW_CELLS = 16  # grid points each side of zero along w
 MAX_STARTS = 24  # local minima started from, least miss first
 # The refinement (`refine`): on the benchmark's 40 round trips (seeds 5 and 6) three
-# levels within about the grid's own run-outs found the generating state of both
+# levels within about half the grid's own run-outs found the generating state of both
 # fits whose grid search had missed it (seed 5 row 13, seed 6 row 18), and nothing
 # that does not reach the rest pose (docs/runout.md, "The grid search").
 REFINE_LEVELS = 3  # halvings of the spacing
-REFINE_RUNOUTS = 24_000
+REFINE_RUNOUTS = 12_000  # about half the grid's own
 NEW_POINTS = 19  # run-outs to halve a cell: its 3 x 3 x 3 points but the 8 corners it has
-SETTLE_CELLS = 1_000  # open cells of the finest level the quasi-Newton starts from
+SETTLE_CELLS = 500  # open cells of the finest level the quasi-Newton starts from
 SETTLE_ITERATIONS = 8
 SETTLE_TOLS = (1e-2, 1e-3)  # m, rad: near enough for fit.py's Newton to polish
 SETTLE_TOL = 1e-6  # integrator tolerance of its run-outs
