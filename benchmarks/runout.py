@@ -275,20 +275,28 @@ _FIRST_USE = (
 def _first_use() -> dict:
     """Seconds of import + impactsym.runout on examples/runout/fit_tbone.json (both cars
     fitted to rest) in a fresh process with an empty numba cache: as given (static
-    loads) and with cg_height 0.55 m on both cars (the _lt kernels), alternating, twice."""
+    loads) and with cg_height 0.55 m on both cars (the _lt kernels), each with the
+    second compiling process (impactsym/runout/prime.py) and without it
+    (IMPACTSYM_PRIME=0), the four alternating, twice."""
     scene = json.loads((Path(__file__).resolve().parents[1] / "examples/runout/fit_tbone.json").read_text())
     moved = json.loads(json.dumps(scene))
     for v in moved["vehicles"]:
         v["cg_height"] = 0.55
-    out = {"static": [], "transfer": []}
+    runs = {
+        "static": (scene, "1"),
+        "transfer": (moved, "1"),
+        "static, one process": (scene, "0"),
+        "transfer, one process": (moved, "0"),
+    }
+    out = {label: [] for label in runs}
     for _ in range(2):
-        for label, data in (("static", scene), ("transfer", moved)):
+        for label, (data, prime) in runs.items():
             with tempfile.TemporaryDirectory() as cache:
                 proc = subprocess.run(
                     [sys.executable, "-c", _FIRST_USE, json.dumps(data)],
                     capture_output=True,
                     text=True,
-                    env=dict(os.environ, NUMBA_CACHE_DIR=cache),
+                    env=dict(os.environ, NUMBA_CACHE_DIR=cache, IMPACTSYM_PRIME=prime),
                     timeout=600,
                     check=True,
                 )
@@ -304,9 +312,9 @@ def _transfer_line(t: dict) -> str:
     if "first_use_s" in t:
         f = t["first_use_s"]
         line += (
-            " First use (fit_tbone.json, empty numba cache, fresh process): static "
-            f"{', '.join(f'{x:.2f}' for x in f['static'])} s, with cg_height "
-            f"{', '.join(f'{x:.2f}' for x in f['transfer'])} s."
+            " First use (fit_tbone.json, empty numba cache, fresh process): "
+            + "; ".join(f"{label} {', '.join(f'{x:.2f}' for x in runs)} s" for label, runs in f.items())
+            + " (static: as given; transfer: with cg_height; one process: IMPACTSYM_PRIME=0)."
         )
     return line
 

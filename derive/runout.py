@@ -58,6 +58,7 @@ a change of a jitted callee in another file).
 from __future__ import annotations
 
 import random
+import re
 
 import mpmath
 import sympy as sp
@@ -746,7 +747,12 @@ class SaturatingPrinter(RunoutPrinter):
 
 PRINTER = RunoutPrinter({"fully_qualified_modules": True, "standard": "python3"})
 SATURATING = SaturatingPrinter({"fully_qualified_modules": True, "standard": "python3"})
+# The entry points (the row functions and batch drivers, called from Python).
 JIT = 'njit(cache=True, error_model="numpy")'
+# Every other kernel is called only from kernels: without the CPython wrapper
+# numba builds, optimises and compiles for each function, a first fit with
+# cg_height compiled in 7.3-7.7 s against 8.0-8.6 s (docs/runout.md, "First use").
+JIT_INNER = 'njit(cache=True, error_model="numpy", no_cpython_wrapper=True)'
 
 
 def wheel_function(name: str, locked: bool, jacobian: bool) -> tuple[str, int]:
@@ -764,7 +770,7 @@ def wheel_function(name: str, locked: bool, jacobian: bool) -> tuple[str, int]:
     saturating = not (locked or jacobian)
     printer = SATURATING if saturating else PRINTER
     args = WHEEL_ARGS + ((tl,) if saturating else ())
-    lines = [f"@{JIT}"]
+    lines = [f"@{JIT_INNER}"]
     lines += emit._wrap(f"def {name}(", [str(a) for a in args], "):", " " * 8)
     lines.append(f'    """Wheel {kind} (conventions.md, run-out; derive/runout.py): {what}."""')
     lines += [f"    {t} = {printer.doprint(x)}" for t, x in temps]
@@ -823,6 +829,38 @@ def _w_constants() -> list[str]:
         f"SENS_SHARE = {SENS_SHARE!r}  # a sensitivity S is held to SENS_SHARE tol (1 + |S|) per explicit step",
         f"KINK_PAST = {KINK_PAST!r}  # a trial rejected across a kink retries to KINK_PAST times the kink's fraction",
         f"KINK_MIN = {KINK_MIN!r}  # of the step, at least",
+    ]
+
+
+# The kernels a first use compiles in a second process while the first compiles
+# the run-out's row function (impactsym/runout/prime.py): callees of the row
+# functions whose compile the first process reaches only after its right-hand
+# side's, in the order it reaches them, with the argument types the row
+# functions pass them (numba's signature syntax; tests/test_runout_prime.py
+# checks that a first use loads each from the cache). A first fit with cg_height
+# on an empty cache: 5.0-5.7 s, 7.1-8.0 s without the second process; this
+# order against the same list last first and with _rhs_sens first
+# (docs/runout.md, "First use").
+_V, _M = "float64[::1]", "float64[:, ::1]"
+PRIME = (
+    ("_jac", (_V, _V, _M, _M)),
+    ("_stiffness", (_M, "float64")),
+    ("_w_inverse", (_M, "float64")),
+    ("_w_stage", (_M, "int64", _V, "float64", "float64", _M, _M, "float64", "float64", _V)),
+    ("_kink", (_V, _V, _V, _M)),
+    ("_to_stop", (_V, _V, _V, _V, "float64", "float64", _V)),
+)
+
+
+def _prime_lines() -> list[str]:
+    """PRIME as generated source: (kernel, signature) pairs."""
+    pairs = [f'    ("{name}", "({", ".join(types)})"),' for name, types in PRIME]
+    return [
+        "# (kernel, argument types) a second process compiles into numba's cache at a first",
+        "# use while this one compiles the row function (impactsym/runout/prime.py).",
+        "PRIME = (",
+        *pairs,
+        ")",
     ]
 
 
@@ -892,11 +930,16 @@ def render(digest: str) -> dict[str, str]:
         "",
         *_constants(),
         *_w_constants(),
+        *_prime_lines(),
         "",
         *("\n" + f for f in funcs),
         INTEGRATOR_SOURCE,
     ]
-    return {"runout.py": render_plain(digest), "runout_jit.py": "\n".join(parts).rstrip("\n") + "\n"}
+    text = "\n".join(parts).rstrip("\n") + "\n"
+    for name, types in PRIME:  # every primed kernel is an inner kernel taking that many arguments
+        head = re.search(rf"@{re.escape(JIT_INNER)}\ndef {name}\(([^)]*)\):", text)
+        assert head and len(head.group(1).split(",")) == len(types), name
+    return {"runout.py": render_plain(digest), "runout_jit.py": text}
 
 
 def _wheel_call(load: str, jacobian: bool) -> str:
@@ -1063,20 +1106,31 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
     in place on y. Non-stiff steps: Dormand-Prince 5(4) (FSAL, local
     extrapolation; tableau DP_A, error weights DP_E). Stiff steps (a wheel near
     stick, where a smoothed sign is a damper of slope mu N/EPS): the L-stable
-    Rosenbrock-W method ROS34PW2 (_wstep). A Dormand-Prince step whose estimate
-    h |lambda| (Hairer's, from its last two stages) exceeds W_ENTER hands the
-    next step to ROS34PW2; a ROS34PW2 step whose h |lambda| (_stiffness, from
-    the Jacobian) is below W_LEAVE hands back. The local error of the state
-    (x, y, psi, vx, vy, w) is kept below `tol` (absolute, SI) per step, and in
-    a Dormand-Prince step each sensitivity S's below SENS_SHARE tol (1 + |S|)
-    (in the forward kernels, which have none, the steps are the state's
-    alone); the distance rides on the same steps. A step after a rejected
-    trial does not grow. The step in which the vehicle stops is cut back to
-    where _speed falls through V_STOP (_to_stop). Accepted points go to `path`
-    while it has room: __PATH_DOC__.
-    Returns (t, status, steps, points). (The stages are a loop with one call of
-    the right-hand side, not written out: numba inlines every call site, and
-    seven of them tripled the compile time of first use.)"""
+    Rosenbrock-W method ROS34PW2 (constants W_*; stage i solves the linear
+    system (I - h GAMMA J) k_i = h f(y + sum_j ALPHA_ij k_j) + h J sum_j
+    GAMMAS_ij k_j with J the Jacobian at y (_jac; the distance's row d|v|/dv; each sensitivity column
+    takes the state's block, the second derivatives of the wheel forces left
+    out, which a W-method allows); the local error is the largest difference
+    from the embedded solution over the state). A Dormand-Prince step whose
+    estimate h |lambda| (Hairer's, from its last two stages) exceeds W_ENTER
+    hands the next step to ROS34PW2; a ROS34PW2 step whose h |lambda|
+    (_stiffness, from the Jacobian) is below W_LEAVE hands back. The local
+    error of the state (x, y, psi, vx, vy, w) is kept below `tol` (absolute,
+    SI) per step, and in a Dormand-Prince step each sensitivity S's below
+    SENS_SHARE tol (1 + |S|) (in the forward kernels, which have none, the
+    steps are the state's alone); the distance rides on the same steps. A step
+    after a rejected trial does not grow. The step in which the vehicle stops
+    is cut back to where _speed falls through V_STOP (_to_stop). Accepted
+    points go to `path` while it has room: __PATH_DOC__.
+    Returns (t, status, steps, points).
+
+    The ROS34PW2 step is written here, not a function of its own: numba links
+    and optimises every callee again into each caller's module, and the level
+    fewer cut a first use's compile by 0.3-0.5 s (docs/runout.md, "First use").
+    The row function stays apart: with it merged in, the run-outs with
+    sensitivities ran 7-15 % slower. The stages are a loop with one call of
+    the right-hand side, not written out: seven call sites tripled the compile
+    time of first use."""
     n = y.shape[0]
     k = np.empty((7, n))
     z = np.empty(n)
@@ -1085,6 +1139,7 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
     f0 = np.empty(n)
     K = np.empty((4, n))
     J = np.empty((3, 4))
+    scratch = np.empty(12)
     t = 0.0
     h = H0
     steps = 0
@@ -1113,7 +1168,31 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
                 wait = W_WAIT
         if stiff:
             taken = True
-            err = _wstep__SUFFIX__(y, P, W, h, k[0], J, K, z, k[1], k[2])/tol
+            # one ROS34PW2 step: stages into K (k[1] the right-hand side at
+            # each stage's point), the new state into k[2]
+            hg = h*W_GAMMA
+            Q = _w_inverse(J, hg)
+            speed = math.sqrt(y[3]*y[3] + y[4]*y[4])
+            ex = y[3]/speed if speed > 0.0 else 0.0
+            ey = y[4]/speed if speed > 0.0 else 0.0
+            for i in range(4):
+                if i == 0:
+                    for c in range(n):
+                        k[1, c] = k[0, c]
+                else:
+                    for c in range(n):
+                        acc = y[c]
+                        for j in range(i):
+                            acc += W_ALPHA[i, j]*K[j, c]
+                        z[c] = acc
+                    _rhs__SUFFIX__(z, P, W, k[1])
+                _w_stage(K, i, k[1], h, hg, J, Q, ex, ey, scratch)
+            err = 0.0
+            for c in range(n):
+                k[2, c] = y[c] + W_B[0]*K[0, c] + W_B[1]*K[1, c] + W_B[2]*K[2, c] + W_B[3]*K[3, c]
+            for c in range(6):
+                err = max(err, abs(W_E[0]*K[0, c] + W_E[1]*K[1, c] + W_E[2]*K[2, c] + W_E[3]*K[3, c]))
+            err = err/tol
             if not (err <= 1.0):  # rejected (NaN included)
                 h *= 0.1 if not math.isfinite(err) else max(0.2, 0.9*err**(-1.0/3.0))
                 rejected = True
@@ -1186,43 +1265,6 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
         # grown fivefold and rejected (docs/runout.md, "Steps").
         h = min(h*(min(grow, 1.0) if rejected else grow), H_MAX)
         rejected = False
-
-
-'''
-WSTEP_TEMPLATE = '''@__JIT__
-def _wstep__SUFFIX__(y, P, W, h, f0, J, K, z, fz, ynew):
-    """One ROS34PW2 step (constants W_*): stage i solves
-    (I - h GAMMA J) k_i = h f(y + sum_j ALPHA_ij k_j) + h J sum_j GAMMAS_ij k_j
-    with J the Jacobian at y (_jac; the distance's row d|v|/dv; each
-    sensitivity column takes the state's block, the second derivatives of the
-    wheel forces left out, which a W-method allows). f0 = f(y); writes the
-    new state y + sum_i B_i k_i to ynew and returns the largest difference
-    from the embedded solution over the state, the local error estimate."""
-    n = y.shape[0]
-    hg = h*W_GAMMA
-    Q = _w_inverse(J, hg)
-    speed = math.sqrt(y[3]*y[3] + y[4]*y[4])
-    ex = y[3]/speed if speed > 0.0 else 0.0
-    ey = y[4]/speed if speed > 0.0 else 0.0
-    scratch = np.empty(12)
-    for i in range(4):
-        if i == 0:
-            for c in range(n):
-                fz[c] = f0[c]
-        else:
-            for c in range(n):
-                acc = y[c]
-                for j in range(i):
-                    acc += W_ALPHA[i, j]*K[j, c]
-                z[c] = acc
-            _rhs__SUFFIX__(z, P, W, fz)
-        _w_stage(K, i, fz, h, hg, J, Q, ex, ey, scratch)
-    err = 0.0
-    for c in range(n):
-        ynew[c] = y[c] + W_B[0]*K[0, c] + W_B[1]*K[1, c] + W_B[2]*K[2, c] + W_B[3]*K[3, c]
-    for c in range(6):
-        err = max(err, abs(W_E[0]*K[0, c] + W_E[1]*K[1, c] + W_E[2]*K[2, c] + W_E[3]*K[3, c]))
-    return err
 
 
 '''
@@ -1473,7 +1515,7 @@ def _jac_lt(y, P, W, J):
 
 
 '''
-ROW_TEMPLATE = '''@__JIT__
+ROW_TEMPLATE = '''@__ENTRY__
 def runout_row__SUFFIX__(v, tol, eps, path):
     """One run-out: v the COLUMNS values (SI, radians). Returns (y, t, status,
     steps, points): y = (x, y, psi, vx, vy, w, distance) at rest__DOC__."""
@@ -1557,7 +1599,7 @@ def switching_source() -> str:
     temps, reduced = sp.cse(switching_functions(False), symbols=sp.numbered_symbols("_t"))
     lines = [f"    {t} = {PRINTER.doprint(x)}" for t, x in temps]
     lines += emit._wrap("    return (", [PRINTER.doprint(x) for x in reduced], ")", " " * 8)
-    return SWITCHING_SOURCE.replace("__ROLLING__", "\n".join(lines)).replace("__JIT__", JIT)
+    return SWITCHING_SOURCE.replace("__ROLLING__", "\n".join(lines)).replace("__JIT__", JIT_INNER)
 
 
 SWITCHING_SOURCE = '''@__JIT__
@@ -1593,14 +1635,15 @@ def _kink(y0, y1, P, W):
 
 
 def _rows() -> str:
-    """runout_row__SUFFIX__ for every variant (with sensitivities: nogil, 31 states)."""
+    """runout_row__SUFFIX__ for every variant: the forward ones with 7 states,
+    the ones with sensitivities with 31 and nogil (the fit runs its uniqueness
+    starts on threads, impactsym/runout/fit.py)."""
     out = []
     for suffix in VARIANTS:
         text = ROW_TEMPLATE.replace("__SUFFIX__", suffix)
         if "sens" in suffix:
-            # nogil: the fit runs its uniqueness starts on threads (impactsym/runout/fit.py)
             text = (
-                text.replace("@__JIT__", "@" + JIT[:-1] + ", nogil=True)")
+                text.replace("@__ENTRY__", "@" + JIT[:-1] + ", nogil=True)")
                 .replace("__N__", "31")
                 .replace(
                     "__DOC__",
@@ -1613,17 +1656,21 @@ def _rows() -> str:
                 )
             )
         else:
-            text = text.replace("__N__", "7").replace("__DOC__", "").replace("__SINIT__", "")
+            text = (
+                text.replace("@__ENTRY__", "@" + JIT)
+                .replace("__N__", "7")
+                .replace("__DOC__", "")
+                .replace("__SINIT__", "")
+            )
         out.append(text)
     return "\n\n".join(out)
 
 
 INTEGRATOR_SOURCE = (
     INTEGRATOR_SOURCE.replace("__TRANSFER__", TRANSFER_SOURCE)
-    .replace("__TRANSFER_KERNELS__", load_transfer.kernel_source(JIT, PRINTER))
+    .replace("__TRANSFER_KERNELS__", load_transfer.kernel_source(JIT_INNER, PRINTER))
     .replace("__LIFT__", "\n".join(load_transfer.check_lines(PRINTER)))
     .replace("__TRANSFER_SETUP__", "\n".join(load_transfer.setup_lines(PRINTER)))
-    .replace("__JIT__", JIT)
     .replace("__ACC_INIT__", "\n".join(f"    {name} = 0.0" for name in ACC))
     .replace("__ACC_ADD__", _acc_add())
     .replace("__SENS__", "\n".join(line[4:] for line in _sensitivity_lines().splitlines()))
@@ -1632,7 +1679,7 @@ INTEGRATOR_SOURCE = (
         switching_source()
         + W_SOURCE
         + "".join(
-            (WSTEP_TEMPLATE + "\n\n" + _path_writes(INTEGRATE_TEMPLATE, suffix))
+            _path_writes(INTEGRATE_TEMPLATE, suffix)
             .replace("__SUFFIX__", suffix)
             .replace("__LT__", "_lt" if "lt" in suffix else "")
             + "\n\n"
@@ -1650,5 +1697,5 @@ INTEGRATOR_SOURCE = (
             for suffix in ("", "_lt")
         ),
     )
-    .replace("__JIT__", JIT)
+    .replace("__JIT__", JIT_INNER)
 )

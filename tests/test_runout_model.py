@@ -294,9 +294,18 @@ def test_rolling_wheel_shortcut_past_saturation_equals_the_clip():
     the force scale (mu N, and the round-off of u_l over max(|u_l|, eps)), on
     4,000 random states: half anywhere, half at the saturation boundary (a
     slip angle of cap alpha_max up to round-off, or within 0.1 % of it)."""
+    from numba import njit
+
     from impactsym.runout._door import jit
 
     k = jit()
+
+    # the wheel kernels are called only from kernels (no CPython wrapper): call them from one
+    @njit
+    def both(c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps, tl):
+        args = (c, s, vx, vy, w, px, py, cd, sd, n, mu, amax, b, fre, cap, eps)
+        return k._wheel_rolling(*args, tl), k._wheel_rolling_jac(*args)[:3]
+
     rng = np.random.default_rng(23)
     saturated = unsaturated = 0
     for i in range(4000):
@@ -326,8 +335,7 @@ def test_rolling_wheel_shortcut_past_saturation_equals_the_clip():
             cap,
             k.EPS,
         )
-        fast = np.array(k._wheel_rolling(*args, math.tan(cap * amax)))
-        plain_clip = np.array(k._wheel_rolling_jac(*args)[:3])
+        fast, plain_clip = (np.array(r) for r in both(*args, math.tan(cap * amax)))
         # the two kernels form u_l in different orders: a round-off of the contact
         # speeds' size in u_l moves the force by that over max(|u_l|, eps) times mu N
         scale = 3500.0 * 0.8 * (1.0 + (abs(ul) + abs(us) + 10.0) / max(abs(ul), k.EPS))

@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from ..errors import SceneError
-from . import _door, threads
+from . import _door, prime, threads
 
 DEFAULTS = {"alpha_max": math.radians(10.0), "f_r": 0.01, "g": 9.80665, "h": 0.0}
 WHEEL_DEFAULT = 0.0
@@ -106,6 +106,7 @@ def _drive(driver: str, table: np.ndarray, out: dict, tol: float, parallel: bool
     n = table.shape[0]
     plain, jit = _door.plain(), _door.jit()
     kernel = getattr(jit, driver)
+    prime.ahead()
     names = ("x_rest", "y_rest", "psi_rest", "t", "distance", "status", "steps")
     arrays = tuple(out[name] for name in names)
     workers = threads.workers()
@@ -148,6 +149,7 @@ def run_row(
     buffer = np.empty((path_points, path_columns))
     values = np.ascontiguousarray(values, dtype=np.float64)
     row = jit.runout_row_sens_lt if _transferring(values[None])[0] else jit.runout_row_sens
+    prime.ahead()
     y, t, status, steps, points = row(
         values,
         plain.TOL if tol is None else float(tol),
