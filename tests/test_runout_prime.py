@@ -39,6 +39,22 @@ def test_the_second_process_starts_once_and_only_when_it_can_help(monkeypatch):
     assert prime.main([str(ROOT / "elsewhere" / "runout_jit.py")]) == 1
 
 
+def test_no_process_to_be_had_is_no_error(monkeypatch):
+    """A cold cache where no second process can start (Popen fails): the run-out
+    runs as without one."""
+
+    def refuse(*args, **kwargs):
+        raise OSError("no processes left")
+
+    monkeypatch.setattr(prime, "_asked", False)
+    monkeypatch.setattr(prime, "_cold", lambda jit: True)
+    monkeypatch.setattr(prime.subprocess, "Popen", refuse)
+    monkeypatch.delenv("IMPACTSYM_PRIME", raising=False)
+    assert prime.ahead() is None
+    _, _, status, _, _ = run_row(input_table(SLIDE)[0], sens=True)
+    assert status == 0
+
+
 FIRST_USE = textwrap.dedent(
     """
     import json, sys

@@ -41,6 +41,8 @@ def ahead() -> subprocess.Popen | None:
     """Start the second process if this is the process's first call and the
     cache is cold (see the module doc); returns it, else None."""
     global _asked
+    if _asked:  # every run-out after the first: no lock taken
+        return None
     with _lock:
         if _asked:
             return None
@@ -48,17 +50,20 @@ def ahead() -> subprocess.Popen | None:
     if os.environ.get("IMPACTSYM_PRIME", "1") == "0":
         return None
     jit = _door.jit()
-    if not _cold(jit):
+    if not (sys.executable and _cold(jit)):  # no interpreter to start (an embedded Python)
         return None
     paths = [p or os.getcwd() for p in sys.path]  # the same imports as this process
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(paths), IMPACTSYM_PRIME="0")
-    proc = subprocess.Popen(
-        [sys.executable, "-c", SECOND, jit.__file__],
-        stdin=subprocess.DEVNULL,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-        env=env,
-    )
+    try:
+        proc = subprocess.Popen(
+            [sys.executable, "-c", SECOND, jit.__file__],
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            env=env,
+        )
+    except OSError:  # no process to be had: this one compiles everything, as without
+        return None
     atexit.register(_stop, proc)
     return proc
 
