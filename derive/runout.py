@@ -1108,10 +1108,11 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
     stick, where a smoothed sign is a damper of slope mu N/EPS): the L-stable
     Rosenbrock-W method ROS34PW2 (constants W_*; stage i solves the linear
     system (I - h GAMMA J) k_i = h f(y + sum_j ALPHA_ij k_j) + h J sum_j
-    GAMMAS_ij k_j with J the Jacobian at y (_jac; the distance's row d|v|/dv; each sensitivity column
-    takes the state's block, the second derivatives of the wheel forces left
-    out, which a W-method allows); the local error is the largest difference
-    from the embedded solution over the state). A Dormand-Prince step whose
+    GAMMAS_ij k_j with J the Jacobian at y (_jac; the distance's row
+    d|v|/dv; each sensitivity column takes the state's block, the second
+    derivatives of the wheel forces left out, which a W-method allows); the
+    local error is the largest difference from the embedded solution over
+    the state). A Dormand-Prince step whose
     estimate h |lambda| (Hairer's, from its last two stages) exceeds W_ENTER
     hands the next step to ROS34PW2; a ROS34PW2 step whose h |lambda|
     (_stiffness, from the Jacobian) is below W_LEAVE hands back. The local
@@ -1125,8 +1126,10 @@ def _integrate__SUFFIX__(y, P, W, tol, path):
     Returns (t, status, steps, points).
 
     The ROS34PW2 step is written here, not a function of its own: numba links
-    and optimises every callee again into each caller's module, and the level
-    fewer cut a first use's compile by 0.3-0.5 s (docs/runout.md, "First use").
+    and optimises every callee again into each caller's module; with the
+    level fewer and the inner kernels' wrappers gone (JIT_INNER) a first fit
+    with cg_height compiled in 7.8-8.0 s against 8.6-8.9 s (docs/runout.md,
+    "First use").
     The row function stays apart: with it merged in, the run-outs with
     sensitivities ran 7-15 % slower. The stages are a loop with one call of
     the right-hand side, not written out: seven call sites tripled the compile
